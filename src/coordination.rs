@@ -1,0 +1,285 @@
+//! Coordination of several sensors' searches (the paper's steps 5–7, and ours).
+//!
+//! - [`Coordination::None`]: each sensor searches alone.
+//! - [`Coordination::Priority`]: each sensor searches alone; sensors are
+//!   ranked by the value of their path, highest first (ties: request order);
+//!   each next sensor searches again with its values reduced for the fields
+//!   of view of all higher-ranked sensors at the same step.
+//! - [`Coordination::Iterated`]: starts from `Priority`, then in rounds every
+//!   sensor, in rank order, searches again against all the others' current
+//!   paths, taking the new path only if it raises the total; it stops when a
+//!   round changes nothing, or after 10 rounds.
+//!
+//! The total is `Σ_t Σ_p value(p, cell_p(t), t, FOVs of the sensors ranked
+//! above p at t)`: for the exact estimator the expected number of distinct
+//! targets detected, whatever the order. In `Iterated` a sensor's value for a
+//! cell is the change in that total when it stands there (its marginal
+//! against all the others for the exact estimator; for the paper estimator
+//! also the change in the lower-ranked sensors' overlap reductions), so each
+//! accepted change raises the total and it never ends below `Priority`.
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::estimator::Estimator;
+use crate::geometry::Region;
+use crate::scenario::{Cell, Scenario};
+use crate::search::{BestPath, ValueGrid, best_path};
+
+/// How sensors' searches are coordinated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Coordination {
+    /// Every sensor plans alone (the paper's 'b' rows).
+    None,
+    /// The paper's priority scheme (the 'a' rows).
+    #[default]
+    Priority,
+    /// Priority, then best-response rounds against all others.
+    Iterated,
+}
+
+/// Largest number of best-response rounds in `Iterated`.
+pub const MAX_ROUNDS: usize = 10;
+
+/// One sensor's plan.
+#[derive(Debug, Clone)]
+pub struct SensorPlan {
+    /// Cells at steps 1..=T.
+    pub path: Vec<Cell>,
+    /// The value its final search maximised.
+    pub value: f64,
+    /// The values that search used.
+    pub grid: ValueGrid,
+}
+
+/// Plans of every sensor, in request order, with their ranks.
+#[derive(Debug, Clone)]
+pub struct Coordinated {
+    /// Per sensor, in request order.
+    pub plans: Vec<SensorPlan>,
+    /// Sensor indices from highest to lowest priority.
+    pub order: Vec<usize>,
+    /// Estimated distinct detections at steps 1..=T.
+    pub by_step: Vec<f64>,
+    /// Best-response rounds run (iterated only).
+    pub rounds: usize,
+}
+
+/// Plans `starts.len()` sensors over `horizon` steps.
+pub fn coordinate(
+    s: &Scenario,
+    est: &dyn Estimator,
+    starts: &[Cell],
+    horizon: usize,
+    mode: Coordination,
+) -> Coordinated {
+    let n = starts.len();
+    // Every sensor alone.
+    let mut plans: Vec<SensorPlan> = (0..n)
+        .into_par_iter()
+        .map(|i| search(s, starts[i], horizon, |k, t| est.value(i, k, t, &[])))
+        .collect();
+    let mut order: Vec<usize> = (0..n).collect();
+    // Stable sort: ties keep request order.
+    order.sort_by(|&a, &b| plans[b].value.total_cmp(&plans[a].value));
+    let mut rounds = 0;
+    if mode != Coordination::None {
+        // Priority: each sensor against the ones above it, in rank order.
+        for rank in 1..order.len() {
+            let i = order[rank];
+            let above = &order[..rank];
+            let plan = {
+                let fovs = fovs_by_step(s, &plans, above, horizon, starts[i]);
+                search(s, starts[i], horizon, |k, t| {
+                    est.value(i, k, t, &fovs[t - 1])
+                })
+            };
+            plans[i] = plan;
+        }
+    }
+    if mode == Coordination::Iterated {
+        let mut changed = true;
+        while changed && rounds < MAX_ROUNDS {
+            changed = false;
+            rounds += 1;
+            for rank in 0..order.len() {
+                let i = order[rank];
+                let grid_plan = if est.order_independent() {
+                    let others: Vec<usize> = order.iter().copied().filter(|&j| j != i).collect();
+                    let fovs = fovs_by_step(s, &plans, &others, horizon, starts[i]);
+                    search(s, starts[i], horizon, |k, t| {
+                        est.value(i, k, t, &fovs[t - 1])
+                    })
+                } else {
+                    search(s, starts[i], horizon, |k, t| {
+                        total_change(s, est, &plans, &order, rank, k, t)
+                    })
+                };
+                let current = path_moves(starts[i], &plans[i].path);
+                let current_value = grid_plan
+                    .grid
+                    .path_value(&current)
+                    .unwrap_or(f64::NEG_INFINITY);
+                let tol = 1e-9 * current_value.abs().max(1.0);
+                if grid_plan.value > current_value + tol {
+                    plans[i] = grid_plan;
+                    changed = true;
+                } else {
+                    plans[i] = SensorPlan {
+                        value: current_value,
+                        path: std::mem::take(&mut plans[i].path),
+                        grid: grid_plan.grid,
+                    };
+                }
+            }
+        }
+    }
+    let by_step = (1..=horizon)
+        .map(|t| {
+            order
+                .iter()
+                .enumerate()
+                .map(|(rank, &p)| {
+                    let above: Vec<Region> = order[..rank]
+                        .iter()
+                        .map(|&q| s.fov_region(plans[q].path[t - 1]))
+                        .collect();
+                    est.value(p, plans[p].path[t - 1], t, &above)
+                })
+                .sum()
+        })
+        .collect();
+    Coordinated {
+        plans,
+        order,
+        by_step,
+        rounds,
+    }
+}
+
+/// For the paper estimator, whose total depends on rank order: the change
+/// in the total at step `t` when the sensor ranked `rank` stands at `k`
+/// instead of being absent. Its own value against the sensors above it,
+/// plus the change it causes in the reductions of the sensors below it.
+fn total_change(
+    s: &Scenario,
+    est: &dyn Estimator,
+    plans: &[SensorPlan],
+    order: &[usize],
+    rank: usize,
+    k: Cell,
+    t: usize,
+) -> f64 {
+    let i = order[rank];
+    let fk = s.fov_region(k);
+    let above: Vec<Region> = order[..rank]
+        .iter()
+        .map(|&q| s.fov_region(plans[q].path[t - 1]))
+        .collect();
+    let mut delta = est.value(i, k, t, &above);
+    for (lower_rank, &q) in order.iter().enumerate().skip(rank + 1) {
+        let fq = s.fov_region(plans[q].path[t - 1]);
+        if !fq.may_overlap(&fk) {
+            continue;
+        }
+        let mut above_q: Vec<Region> = order[..lower_rank]
+            .iter()
+            .filter(|&&p| p != i)
+            .map(|&p| s.fov_region(plans[p].path[t - 1]))
+            .collect();
+        let without = est.value(q, plans[q].path[t - 1], t, &above_q);
+        above_q.push(fk);
+        let with = est.value(q, plans[q].path[t - 1], t, &above_q);
+        delta += with - without;
+    }
+    delta
+}
+
+/// The fields of view, at each step, of the `sensors` on their current
+/// paths, keeping those that can meet a cell reachable from `start`.
+fn fovs_by_step(
+    s: &Scenario,
+    plans: &[SensorPlan],
+    sensors: &[usize],
+    horizon: usize,
+    start: Cell,
+) -> Vec<Vec<Region>> {
+    (1..=horizon)
+        .map(|t| {
+            let reach = reach_box(s, start, t);
+            sensors
+                .iter()
+                .map(|&q| s.fov_region(plans[q].path[t - 1]))
+                .filter(|r| r.may_overlap(&reach))
+                .collect()
+        })
+        .collect()
+}
+
+/// A region bounding every field of view of a cell reachable in `t` steps.
+fn reach_box(s: &Scenario, start: Cell, t: usize) -> Region {
+    let c = s.centre(start);
+    let half = match s.fov {
+        crate::scenario::FovSpec::Square { half_width } => half_width,
+        crate::scenario::FovSpec::Circle { radius } => radius,
+    } + t as f64 * s.cell_size;
+    Region {
+        rect: crate::geometry::Rect {
+            x0: c.x - half,
+            y0: c.y - half,
+            x1: c.x + half,
+            y1: c.y + half,
+        },
+        disk: None,
+    }
+}
+
+fn path_moves(start: Cell, path: &[Cell]) -> Vec<(i32, i32)> {
+    let mut prev = start;
+    path.iter()
+        .map(|&c| {
+            let m = (c.col - prev.col, c.row - prev.row);
+            prev = c;
+            m
+        })
+        .collect()
+}
+
+/// Fills a value grid from `value(k, t)` over the reachable on-lattice cells
+/// and searches it.
+fn search(
+    s: &Scenario,
+    start: Cell,
+    horizon: usize,
+    value: impl Fn(Cell, usize) -> f64,
+) -> SensorPlan {
+    let mut grid = ValueGrid::new(horizon);
+    for t in 1..=horizon {
+        let ti = t as i32;
+        for dr in -ti..=ti {
+            for dc in -ti..=ti {
+                let k = Cell {
+                    col: start.col + dc,
+                    row: start.row + dr,
+                };
+                if s.on_lattice(k) {
+                    grid.set(t, dc, dr, value(k, t));
+                }
+            }
+        }
+    }
+    let BestPath { moves, value } = best_path(&grid);
+    let mut c = start;
+    let path = moves
+        .iter()
+        .map(|&(dc, dr)| {
+            c = Cell {
+                col: c.col + dc,
+                row: c.row + dr,
+            };
+            c
+        })
+        .collect();
+    SensorPlan { path, value, grid }
+}

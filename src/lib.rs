@@ -1,0 +1,25 @@
+//! Vigil: T-step ahead planning of mobile surveillance sensors that maximise
+//! the expected number of targets detected, after Krishna, Hexmoor and
+//! Sogani, "A T-Step Ahead Optimal Target Detection Algorithm for a Multi
+//! Sensor Surveillance System".
+//!
+//! The algorithm is plain synchronous code, layered as the paper is:
+//! - [`scenario`]: the model (zone, lattice, sources, field of view), validated once;
+//! - [`stats`]: the offline per-cell statistics (`lambda_hat`, `escape_time`, `d_hat`);
+//! - [`estimator`]: `n̂(k,t)`, by the paper's equations or exactly;
+//! - [`search`]: the best T-step path of one sensor (dynamic programming);
+//! - [`coordination`]: priority and iterated coordination of several sensors;
+//! - [`planner`]: a scenario's planner and the request/response types;
+//! - [`world`]: a simulation of the target process, for checks and simulators.
+//!
+//! [`http`] is the thin HTTP layer over them.
+
+pub mod coordination;
+pub mod estimator;
+pub mod geometry;
+pub mod http;
+pub mod planner;
+pub mod scenario;
+pub mod search;
+pub mod stats;
+pub mod world;

@@ -1,0 +1,440 @@
+//! The planner of one scenario: its statistics, computed once, and
+//! [`Planner::plan`], which turns a plan request into coordinated T-step
+//! paths. Also the request and response types of the planning API, which the
+//! HTTP layer and in-process callers share.
+
+use std::collections::HashSet;
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use crate::coordination::{Coordination, coordinate};
+use crate::estimator::{Estimator, ExactEstimator, PaperEstimator, SourceRays, Target};
+use crate::geometry::{Point, Region};
+use crate::scenario::{Cell, Scenario, ValidationError, check_horizon};
+use crate::stats::Stats;
+
+/// Most sensors in one request.
+pub const MAX_SENSORS: usize = 256;
+/// Most targets in one request.
+pub const MAX_TARGETS: usize = 20_000;
+/// Most steps of history.
+pub const MAX_HISTORY_STEPS: usize = 32;
+/// Most positions in one history step.
+pub const MAX_HISTORY_POSITIONS: usize = 256;
+
+/// Which estimator of `n̂(k,t)` to use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EstimatorKind {
+    /// The conditional expectation under the model (ours).
+    #[default]
+    Exact,
+    /// Equations (1) and (2) of the paper.
+    Paper,
+}
+
+/// What the reported targets cover.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Observed {
+    /// The targets inside the sensors' fields of view (now and in the history).
+    #[default]
+    Sensors,
+    /// Every target in the zone (a clairvoyant reference).
+    Zone,
+}
+
+/// A sensor or target id: a string or a number, echoed back as given.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Id {
+    /// A string id.
+    Text(String),
+    /// A numeric id.
+    Number(serde_json::Number),
+}
+
+impl Id {
+    fn key(&self) -> String {
+        match self {
+            Id::Text(s) => format!("s:{s}"),
+            Id::Number(n) => format!("n:{n}"),
+        }
+    }
+}
+
+/// A sensor's current position.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SensorIn {
+    /// Unique id.
+    pub id: Id,
+    /// East coordinate.
+    pub x: f64,
+    /// North coordinate.
+    pub y: f64,
+}
+
+/// A reported target.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TargetIn {
+    /// Optional id.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub id: Option<Id>,
+    /// East coordinate now.
+    pub x: f64,
+    /// North coordinate now.
+    pub y: f64,
+    /// East displacement per step.
+    pub vx: f64,
+    /// North displacement per step.
+    pub vy: f64,
+}
+
+/// A past sensor position.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PositionIn {
+    /// East coordinate.
+    pub x: f64,
+    /// North coordinate.
+    pub y: f64,
+}
+
+/// Body of `POST /v1/scenarios/{id}/plan`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlanRequest {
+    /// Sensors now.
+    pub sensors: Vec<SensorIn>,
+    /// Targets reported now.
+    #[serde(default)]
+    pub targets: Vec<TargetIn>,
+    /// Sensors' positions 1, 2, … steps ago.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub history: Option<Vec<Vec<PositionIn>>>,
+    /// Horizon T; the scenario's by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub horizon: Option<usize>,
+    /// Estimator; `exact` by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub estimator: Option<EstimatorKind>,
+    /// Coordination; `priority` by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coordination: Option<Coordination>,
+    /// What the reported targets cover; `sensors` by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub observed: Option<Observed>,
+    /// Include the search values in the response.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub explain: Option<bool>,
+}
+
+/// A lattice cell and its centre.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CellOut {
+    /// Column.
+    pub col: i32,
+    /// Row.
+    pub row: i32,
+    /// Centre, east.
+    pub x: f64,
+    /// Centre, north.
+    pub y: f64,
+}
+
+/// The search values of one sensor.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Explain {
+    /// `values[t−1][dr+T][dc+T]`; null where unreachable or off the lattice.
+    pub values: Vec<Vec<Vec<Option<f64>>>>,
+}
+
+/// One sensor's plan.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlanOut {
+    /// The sensor's id.
+    pub sensor: Id,
+    /// Rank, 1 = highest.
+    pub priority: usize,
+    /// The cell it starts from.
+    pub start: CellOut,
+    /// Cells at steps 1..=T.
+    pub path: Vec<CellOut>,
+    /// The value its final search maximised.
+    pub expected_detections: f64,
+    /// Search values, when asked for.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub explain: Option<Explain>,
+}
+
+/// Response of a plan request.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlanResponse {
+    /// Scenario id.
+    pub scenario: String,
+    /// Horizon T used.
+    pub horizon: usize,
+    /// Estimator used.
+    pub estimator: EstimatorKind,
+    /// Coordination used.
+    pub coordination: Coordination,
+    /// Plans in request order.
+    pub plans: Vec<PlanOut>,
+    /// Expected distinct targets detected over steps 1..=T.
+    pub expected_detections: f64,
+    /// The same per step.
+    pub expected_by_step: Vec<f64>,
+    /// Planning time, microseconds.
+    pub compute_micros: u64,
+}
+
+/// A validated plan request.
+#[derive(Debug, Clone)]
+pub struct PlanInput {
+    ids: Vec<Id>,
+    starts: Vec<Cell>,
+    targets: Vec<Target>,
+    history: Vec<Vec<Cell>>,
+    horizon: usize,
+    estimator: EstimatorKind,
+    coordination: Coordination,
+    observed: Observed,
+    explain: bool,
+}
+
+fn finite(field: String, v: f64) -> Result<f64, ValidationError> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(ValidationError::new(field, "must be a finite number"))
+    }
+}
+
+impl PlanInput {
+    /// Validates a request against a scenario.
+    pub fn new(s: &Scenario, req: &PlanRequest) -> Result<Self, ValidationError> {
+        if req.sensors.is_empty() {
+            return Err(ValidationError::new(
+                "sensors",
+                "at least one sensor is required",
+            ));
+        }
+        if req.sensors.len() > MAX_SENSORS {
+            return Err(ValidationError::new(
+                "sensors",
+                format!("at most {MAX_SENSORS} sensors, got {}", req.sensors.len()),
+            ));
+        }
+        if req.targets.len() > MAX_TARGETS {
+            return Err(ValidationError::new(
+                "targets",
+                format!("at most {MAX_TARGETS} targets, got {}", req.targets.len()),
+            ));
+        }
+        let history = req.history.as_deref().unwrap_or(&[]);
+        if history.len() > MAX_HISTORY_STEPS {
+            return Err(ValidationError::new(
+                "history",
+                format!("at most {MAX_HISTORY_STEPS} steps, got {}", history.len()),
+            ));
+        }
+        let in_zone = |field: String, x: f64, y: f64| -> Result<Cell, ValidationError> {
+            let x = finite(format!("{field}.x"), x)?;
+            let y = finite(format!("{field}.y"), y)?;
+            let p = Point::new(x, y);
+            if !s.in_zone(p) {
+                return Err(ValidationError::new(
+                    field,
+                    format!(
+                        "({x}, {y}) is outside the zone [0,{}]×[0,{}]",
+                        s.width, s.height
+                    ),
+                ));
+            }
+            Ok(s.snap(p))
+        };
+        let mut seen = HashSet::new();
+        let mut ids = Vec::with_capacity(req.sensors.len());
+        let mut starts = Vec::with_capacity(req.sensors.len());
+        for (i, sensor) in req.sensors.iter().enumerate() {
+            if !seen.insert(sensor.id.key()) {
+                return Err(ValidationError::new(
+                    format!("sensors[{i}].id"),
+                    "duplicate sensor id",
+                ));
+            }
+            starts.push(in_zone(format!("sensors[{i}]"), sensor.x, sensor.y)?);
+            ids.push(sensor.id.clone());
+        }
+        let mut targets = Vec::with_capacity(req.targets.len());
+        for (i, t) in req.targets.iter().enumerate() {
+            let f = |n: &str| format!("targets[{i}].{n}");
+            targets.push(Target {
+                pos: Point::new(finite(f("x"), t.x)?, finite(f("y"), t.y)?),
+                vel: Point::new(finite(f("vx"), t.vx)?, finite(f("vy"), t.vy)?),
+            });
+        }
+        let mut past = Vec::with_capacity(history.len());
+        for (si, step) in history.iter().enumerate() {
+            if step.len() > MAX_HISTORY_POSITIONS {
+                return Err(ValidationError::new(
+                    format!("history[{si}]"),
+                    format!(
+                        "at most {MAX_HISTORY_POSITIONS} positions per step, got {}",
+                        step.len()
+                    ),
+                ));
+            }
+            past.push(
+                step.iter()
+                    .enumerate()
+                    .map(|(pi, p)| in_zone(format!("history[{si}][{pi}]"), p.x, p.y))
+                    .collect::<Result<Vec<_>, _>>()?,
+            );
+        }
+        let horizon = check_horizon("horizon", req.horizon.unwrap_or(s.horizon))?;
+        Ok(PlanInput {
+            ids,
+            starts,
+            targets,
+            history: past,
+            horizon,
+            estimator: req.estimator.unwrap_or_default(),
+            coordination: req.coordination.unwrap_or_default(),
+            observed: req.observed.unwrap_or_default(),
+            explain: req.explain.unwrap_or(false),
+        })
+    }
+}
+
+/// A scenario with its precomputed statistics, ready to plan.
+#[derive(Debug)]
+pub struct Planner {
+    /// The scenario.
+    pub scenario: Scenario,
+    /// Its per-cell statistics.
+    pub stats: Stats,
+    rays: Vec<SourceRays>,
+    /// Time the precomputation took, milliseconds.
+    pub precompute_ms: f64,
+}
+
+impl Planner {
+    /// Precomputes the statistics of a scenario.
+    pub fn new(scenario: Scenario) -> Self {
+        let started = Instant::now();
+        let stats = Stats::compute(&scenario);
+        let rays = SourceRays::for_scenario(&scenario);
+        Planner {
+            scenario,
+            stats,
+            rays,
+            precompute_ms: started.elapsed().as_secs_f64() * 1e3,
+        }
+    }
+
+    /// Validates and plans a request.
+    pub fn plan_request(&self, req: &PlanRequest) -> Result<PlanResponse, ValidationError> {
+        Ok(self.plan(&PlanInput::new(&self.scenario, req)?))
+    }
+
+    /// Plans a validated request.
+    pub fn plan(&self, input: &PlanInput) -> PlanResponse {
+        let started = Instant::now();
+        let s = &self.scenario;
+        let est: Box<dyn Estimator + '_> = match input.estimator {
+            EstimatorKind::Paper => Box::new(PaperEstimator::new(
+                s,
+                &self.stats,
+                &input.starts,
+                &input.targets,
+            )),
+            EstimatorKind::Exact => {
+                let observed = self.observed_regions(input);
+                Box::new(ExactEstimator::new(
+                    s,
+                    &self.stats,
+                    &self.rays,
+                    &observed,
+                    &input.targets,
+                ))
+            }
+        };
+        let result = coordinate(
+            s,
+            est.as_ref(),
+            &input.starts,
+            input.horizon,
+            input.coordination,
+        );
+        let cell_out = |c: Cell| {
+            let p = s.centre(c);
+            CellOut {
+                col: c.col,
+                row: c.row,
+                x: p.x,
+                y: p.y,
+            }
+        };
+        let mut rank = vec![0; input.starts.len()];
+        for (r, &i) in result.order.iter().enumerate() {
+            rank[i] = r + 1;
+        }
+        let plans = result
+            .plans
+            .iter()
+            .enumerate()
+            .map(|(i, p)| PlanOut {
+                sensor: input.ids[i].clone(),
+                priority: rank[i],
+                start: cell_out(input.starts[i]),
+                path: p.path.iter().map(|&c| cell_out(c)).collect(),
+                expected_detections: p.value,
+                explain: input.explain.then(|| Explain {
+                    values: p.grid.to_nested(),
+                }),
+            })
+            .collect();
+        PlanResponse {
+            scenario: s.id.clone(),
+            horizon: input.horizon,
+            estimator: input.estimator,
+            coordination: input.coordination,
+            plans,
+            expected_detections: result.by_step.iter().sum(),
+            expected_by_step: result.by_step,
+            compute_micros: started.elapsed().as_micros() as u64,
+        }
+    }
+
+    /// `O_s` for s = 0, 1, …: the fields of view now and in the history
+    /// (the whole zone now, when the caller reports every target in it).
+    fn observed_regions(&self, input: &PlanInput) -> Vec<Vec<Region>> {
+        let s = &self.scenario;
+        let now = match input.observed {
+            Observed::Zone => vec![s.zone_region()],
+            Observed::Sensors => dedup(&input.starts)
+                .into_iter()
+                .map(|c| s.fov_region(c))
+                .collect(),
+        };
+        std::iter::once(now)
+            .chain(
+                input
+                    .history
+                    .iter()
+                    .map(|step| dedup(step).into_iter().map(|c| s.fov_region(c)).collect()),
+            )
+            .collect()
+    }
+}
+
+fn dedup(cells: &[Cell]) -> Vec<Cell> {
+    let mut v = cells.to_vec();
+    v.sort();
+    v.dedup();
+    v
+}

@@ -1,0 +1,157 @@
+//! A simulation of the target process itself, independent of the estimators:
+//! each source emits targets as a Poisson process in continuous time with a
+//! uniform takeoff angle over its half-plane; targets fly straight at the
+//! scenario's speed, exist while inside the closed zone, and are gone once
+//! they leave it.
+//!
+//! Used by the Monte Carlo checks of the statistics and the estimators, and
+//! by the simulation client.
+
+use rand::RngExt;
+use rand_distr::{Distribution, Poisson};
+
+use crate::geometry::Point;
+use crate::scenario::Scenario;
+
+/// A target in flight (it may not have reached the zone yet).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimTarget {
+    /// Unique id, in order of emission.
+    pub id: u64,
+    /// Position now.
+    pub pos: Point,
+    /// Displacement per step.
+    pub vel: Point,
+    /// Has been inside the zone.
+    pub entered: bool,
+    /// Index of its source.
+    pub source: usize,
+}
+
+/// The targets of a scenario at an integer time.
+#[derive(Debug, Clone)]
+pub struct World {
+    /// Targets in flight: inside the zone, or still on their way to it.
+    pub targets: Vec<SimTarget>,
+    next_id: u64,
+    /// How far from a source a target can still meet the zone.
+    reach: Vec<f64>,
+}
+
+impl World {
+    /// An empty world (no target emitted yet).
+    pub fn empty(s: &Scenario) -> Self {
+        let reach = s
+            .sources
+            .iter()
+            .map(|src| {
+                [
+                    (0.0, 0.0),
+                    (s.width, 0.0),
+                    (0.0, s.height),
+                    (s.width, s.height),
+                ]
+                .iter()
+                .map(|&(x, y)| (x - src.pos.x).hypot(y - src.pos.y))
+                .fold(0.0, f64::max)
+            })
+            .collect();
+        World {
+            targets: Vec::new(),
+            next_id: 0,
+            reach,
+        }
+    }
+
+    /// A world drawn from the stationary distribution: targets emitted over
+    /// a window long enough for any to have crossed the zone, as if the
+    /// process had always run.
+    pub fn stationary(s: &Scenario, rng: &mut impl rand::Rng) -> Self {
+        let mut w = World::empty(s);
+        for j in 0..s.sources.len() {
+            let window = w.reach[j] / s.speed;
+            w.emit(s, j, window, rng);
+        }
+        w
+    }
+
+    /// Emits source `j`'s targets of the last `window` steps (continuous
+    /// emission times), placed where they are now.
+    fn emit(&mut self, s: &Scenario, j: usize, window: f64, rng: &mut impl rand::Rng) {
+        let src = &s.sources[j];
+        let mean = src.rate * window;
+        if mean <= 0.0 {
+            return;
+        }
+        let count = match Poisson::new(mean) {
+            Ok(p) => p.sample(rng) as u64,
+            Err(_) => 0,
+        };
+        for _ in 0..count {
+            let age = rng.random::<f64>() * window;
+            let alpha = (rng.random::<f64>() - 0.5) * std::f64::consts::PI;
+            let u = src.direction(alpha);
+            let dist = s.speed * age;
+            let pos = Point::new(src.pos.x + u.x * dist, src.pos.y + u.y * dist);
+            let mut t = SimTarget {
+                id: self.next_id,
+                pos,
+                vel: Point::new(u.x * s.speed, u.y * s.speed),
+                entered: false,
+                source: j,
+            };
+            self.next_id += 1;
+            // A target's history is known exactly: it entered if its path
+            // from the source has met the zone already.
+            t.entered = s.in_zone(pos) || has_crossed(s, src.pos, u, dist);
+            if self.alive(s, &t) {
+                self.targets.push(t);
+            }
+        }
+    }
+
+    fn alive(&self, s: &Scenario, t: &SimTarget) -> bool {
+        if s.in_zone(t.pos) {
+            return true;
+        }
+        if t.entered {
+            return false;
+        }
+        let src = s.sources[t.source].pos;
+        (t.pos.x - src.x).hypot(t.pos.y - src.y) <= self.reach[t.source]
+    }
+
+    /// Advances one step: every target flies, those that left are removed,
+    /// and each source emits its Poisson count for the step.
+    pub fn step(&mut self, s: &Scenario, rng: &mut impl rand::Rng) {
+        let mut targets = std::mem::take(&mut self.targets);
+        for t in &mut targets {
+            let before = t.pos;
+            t.pos = Point::new(t.pos.x + t.vel.x, t.pos.y + t.vel.y);
+            if !t.entered && (s.in_zone(t.pos) || segment_meets_zone(s, before, t.pos)) {
+                t.entered = true;
+            }
+        }
+        targets.retain(|t| self.alive(s, t));
+        self.targets = targets;
+        for j in 0..s.sources.len() {
+            self.emit(s, j, 1.0, rng);
+        }
+    }
+
+    /// Targets inside the closed zone now.
+    pub fn in_zone<'a>(&'a self, s: &'a Scenario) -> impl Iterator<Item = &'a SimTarget> + 'a {
+        self.targets.iter().filter(move |t| s.in_zone(t.pos))
+    }
+}
+
+/// True when the segment from `p` along `u` for `len` has met the zone.
+fn has_crossed(s: &Scenario, p: Point, u: Point, len: f64) -> bool {
+    segment_meets_zone(s, p, Point::new(p.x + u.x * len, p.y + u.y * len))
+}
+
+fn segment_meets_zone(s: &Scenario, a: Point, b: Point) -> bool {
+    let d = Point::new(b.x - a.x, b.y - a.y);
+    let inv = Point::new(1.0 / d.x, 1.0 / d.y);
+    s.zone().ray(a, d, inv).is_some_and(|(t0, _)| t0 <= 1.0)
+}

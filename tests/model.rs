@@ -1,0 +1,463 @@
+//! Statistical checks of the model against an independent Monte Carlo of the
+//! target process ([`vigil::world`]), and of coordination's guarantees.
+//!
+//! Tolerances come from the standard error of the Monte Carlo mean, so a
+//! correct implementation fails with negligible probability (seeds are
+//! fixed, so the runs are also reproducible).
+#![allow(clippy::unwrap_used)]
+
+use rand::{SeedableRng, rngs::StdRng};
+use rayon::prelude::*;
+use vigil::coordination::Coordination;
+use vigil::estimator::{Estimator, ExactEstimator, SourceRays, Target};
+use vigil::geometry::{Point, Region};
+use vigil::planner::{EstimatorKind, Id, PlanRequest, Planner, SensorIn, TargetIn};
+use vigil::scenario::{Cell, FovSpec, Scenario, builtins, paper_spec};
+use vigil::stats::Stats;
+use vigil::world::World;
+
+/// Mean and standard error of the mean.
+fn mean_se(xs: &[f64]) -> (f64, f64) {
+    let n = xs.len() as f64;
+    let m = xs.iter().sum::<f64>() / n;
+    let var = xs.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
+    (m, (var / n).sqrt())
+}
+
+fn circle_scenario() -> Scenario {
+    let mut spec = paper_spec(12.0);
+    spec.name = Some("circle".into());
+    spec.fov = FovSpec::Circle { radius: 35.0 };
+    spec.sources[2].rate = 0.6;
+    Scenario::new(spec).unwrap()
+}
+
+/// Stationary counts in several fields of view and in the zone, averaged over
+/// independent stationary worlds, match `d_hat` and
+/// `expected_targets_in_zone` within 1% plus three standard errors.
+#[test]
+fn d_hat_matches_monte_carlo() {
+    for s in [builtins().remove(0), circle_scenario()] {
+        let stats = Stats::compute(&s);
+        let cells =
+            [(0, 0), (3, 15), (15, 15), (29, 8), (10, 27)].map(|(col, row)| Cell { col, row });
+        let regions: Vec<Region> = cells.iter().map(|&c| s.fov_region(c)).collect();
+        let worlds = 40_000;
+        let counts: Vec<Vec<f64>> = (0..worlds)
+            .into_par_iter()
+            .map(|i| {
+                let mut rng = StdRng::seed_from_u64(1_000 + i as u64);
+                let w = World::stationary(&s, &mut rng);
+                let mut out: Vec<f64> = regions
+                    .iter()
+                    .map(|r| w.targets.iter().filter(|t| r.contains(t.pos)).count() as f64)
+                    .collect();
+                out.push(w.in_zone(&s).count() as f64);
+                out
+            })
+            .collect();
+        let mut expected: Vec<f64> = cells.iter().map(|&c| stats.d_hat[s.index(c)]).collect();
+        expected.push(stats.expected_targets_in_zone);
+        for (j, &e) in expected.iter().enumerate() {
+            let col: Vec<f64> = counts.iter().map(|c| c[j]).collect();
+            let (m, se) = mean_se(&col);
+            eprintln!(
+                "{}: quantity {j}: Monte Carlo {m:.4} ± {se:.4}, d_hat {e:.4}",
+                s.id
+            );
+            assert!(
+                (m - e).abs() <= 0.01 * e + 3.0 * se,
+                "{}: quantity {j}: Monte Carlo {m:.4} ± {se:.4}, d_hat {e:.4}",
+                s.id
+            );
+        }
+    }
+}
+
+/// `lambda_hat` is the rate of targets whose straight path meets `F_c`:
+/// checked by drawing takeoff angles and testing each path against the
+/// region's corners (a separate test from the estimator's angular spans).
+#[test]
+fn lambda_hat_matches_monte_carlo() {
+    use rand::RngExt;
+    let s = builtins().remove(0);
+    let stats = Stats::compute(&s);
+    let mut rng = StdRng::seed_from_u64(7);
+    let draws = 200_000;
+    for (col, row) in [(0, 0), (15, 15), (29, 8), (4, 22)] {
+        let c = Cell { col, row };
+        let r = s.fov_region(c).rect;
+        let corners = [(r.x0, r.y0), (r.x1, r.y0), (r.x1, r.y1), (r.x0, r.y1)];
+        let mut rate = 0.0;
+        let mut var = 0.0;
+        for src in &s.sources {
+            let mut hits = 0u32;
+            for _ in 0..draws {
+                let alpha = (rng.random::<f64>() - 0.5) * std::f64::consts::PI;
+                let u = src.direction(alpha);
+                // The path meets the rectangle iff its corners are not all on
+                // one side of the line, and some corner lies ahead.
+                let side = |&(x, y): &(f64, f64)| u.x * (y - src.pos.y) - u.y * (x - src.pos.x);
+                let ahead = corners
+                    .iter()
+                    .any(|&(x, y)| u.x * (x - src.pos.x) + u.y * (y - src.pos.y) > 0.0);
+                let pos = corners.iter().any(|c| side(c) >= 0.0);
+                let neg = corners.iter().any(|c| side(c) <= 0.0);
+                if ahead && pos && neg {
+                    hits += 1;
+                }
+            }
+            let p = hits as f64 / draws as f64;
+            rate += src.rate * p;
+            var += src.rate.powi(2) * p * (1.0 - p) / draws as f64;
+        }
+        let e = stats.lambda_hat[s.index(c)];
+        assert!(
+            (rate - e).abs() <= 0.01 * e + 3.0 * var.sqrt(),
+            "cell {c:?}: Monte Carlo {rate:.5}, lambda_hat {e:.5}"
+        );
+        let esc = stats.escape_time[s.index(c)];
+        assert!((esc * e - stats.d_hat[s.index(c)]).abs() < 1e-9);
+    }
+}
+
+/// How the sensors and the reporting behave in one unbiasedness experiment.
+#[derive(Clone, Copy, Debug)]
+enum Reporting {
+    /// Report what the sensors see now; no history.
+    NowOnly,
+    /// Report targets seen now or in the last `steps` steps (still in the
+    /// zone), and pass the sensors' past positions as history.
+    WithHistory { steps: usize, moving: bool },
+    /// As `WithHistory`, but the history is withheld from the estimator:
+    /// a negative control that must be caught as biased.
+    HistoryWithheld { steps: usize, moving: bool },
+}
+
+struct Experiment {
+    /// Mean and SE of (actual − n̂) per (cell, t).
+    results: Vec<((Cell, usize), f64, f64)>,
+}
+
+fn run_unbiasedness(s: &Scenario, reporting: Reporting, worlds: usize) -> Experiment {
+    let stats = Stats::compute(s);
+    let rays = SourceRays::for_scenario(s);
+    let sensors = [(9, 9), (12, 10), (21, 19)].map(|(col, row)| Cell { col, row });
+    let (steps, moving, pass_history) = match reporting {
+        Reporting::NowOnly => (0, false, false),
+        Reporting::WithHistory { steps, moving } => (steps, moving, true),
+        Reporting::HistoryWithheld { steps, moving } => (steps, moving, false),
+    };
+    // Sensor positions `s` steps ago: fixed, or drifting west one cell a step.
+    let at = |s_ago: usize| -> Vec<Cell> {
+        sensors
+            .iter()
+            .map(|c| Cell {
+                col: if moving { c.col - s_ago as i32 } else { c.col },
+                row: c.row,
+            })
+            .collect()
+    };
+    let probes: Vec<(Cell, usize)> = [
+        ((9, 9), 1),
+        ((9, 9), 3),
+        ((10, 11), 2),
+        ((12, 10), 1),
+        ((14, 12), 3),
+        ((21, 19), 2),
+        ((23, 21), 5),
+        ((5, 20), 2),
+    ]
+    .iter()
+    .map(|&((col, row), t)| (Cell { col, row }, t))
+    .collect();
+    let tmax = probes.iter().map(|p| p.1).max().unwrap_or(1);
+    let diffs: Vec<Vec<f64>> = (0..worlds)
+        .into_par_iter()
+        .map(|i| {
+            let mut rng = StdRng::seed_from_u64(99_000 + i as u64);
+            let mut w = World::stationary(s, &mut rng);
+            let mut seen = std::collections::HashSet::new();
+            for s_ago in (0..=steps).rev() {
+                let fovs: Vec<Region> = at(s_ago).iter().map(|&c| s.fov_region(c)).collect();
+                for t in w.in_zone(s) {
+                    if fovs.iter().any(|r| r.contains(t.pos)) {
+                        seen.insert(t.id);
+                    }
+                }
+                if s_ago > 0 {
+                    w.step(s, &mut rng);
+                }
+            }
+            let reported: Vec<Target> = w
+                .in_zone(s)
+                .filter(|t| seen.contains(&t.id))
+                .map(|t| Target {
+                    pos: t.pos,
+                    vel: t.vel,
+                })
+                .collect();
+            let history_len = if pass_history { steps } else { 0 };
+            let observed: Vec<Vec<Region>> = (0..=history_len)
+                .map(|s_ago| at(s_ago).iter().map(|&c| s.fov_region(c)).collect())
+                .collect();
+            let est = ExactEstimator::new(s, &stats, &rays, &observed, &reported);
+            let predicted: Vec<f64> = probes
+                .iter()
+                .map(|&(k, t)| est.value(0, k, t, &[]))
+                .collect();
+            let mut actual = vec![0.0; probes.len()];
+            for t in 1..=tmax {
+                w.step(s, &mut rng);
+                for (j, &(k, pt)) in probes.iter().enumerate() {
+                    if pt == t {
+                        let r = s.fov_region(k);
+                        actual[j] = w.in_zone(s).filter(|x| r.contains(x.pos)).count() as f64;
+                    }
+                }
+            }
+            actual.iter().zip(&predicted).map(|(a, p)| a - p).collect()
+        })
+        .collect();
+    let results = probes
+        .iter()
+        .enumerate()
+        .map(|(j, &p)| {
+            let col: Vec<f64> = diffs.iter().map(|d| d[j]).collect();
+            let (m, se) = mean_se(&col);
+            (p, m, se)
+        })
+        .collect();
+    Experiment { results }
+}
+
+fn assert_unbiased(e: &Experiment, label: &str) {
+    for &((k, t), m, se) in &e.results {
+        eprintln!(
+            "{label}: cell ({},{}) t={t}: mean(actual − n̂) = {m:+.4} ± {se:.4}",
+            k.col, k.row
+        );
+        // Four standard errors per probe: with 8 probes the chance that a
+        // correct estimator fails is about 5e-4.
+        assert!(
+            m.abs() <= 4.0 * se,
+            "{label}: cell {k:?} t={t}: mean(actual − n̂) = {m:.4} ± {se:.4}"
+        );
+        assert!(
+            se < 0.03,
+            "{label}: too few worlds to be informative (se {se:.4})"
+        );
+    }
+}
+
+#[test]
+fn exact_estimator_is_unbiased_without_history() {
+    let s = builtins().remove(0);
+    assert_unbiased(
+        &run_unbiasedness(&s, Reporting::NowOnly, 12_000),
+        "no history",
+    );
+}
+
+#[test]
+fn exact_estimator_is_unbiased_with_history() {
+    let s = builtins().remove(1);
+    assert_unbiased(
+        &run_unbiasedness(
+            &s,
+            Reporting::WithHistory {
+                steps: 4,
+                moving: false,
+            },
+            12_000,
+        ),
+        "fixed sensors, 4 steps of history",
+    );
+    let s = builtins().remove(0);
+    assert_unbiased(
+        &run_unbiasedness(
+            &s,
+            Reporting::WithHistory {
+                steps: 3,
+                moving: true,
+            },
+            12_000,
+        ),
+        "moving sensors, 3 steps of history",
+    );
+}
+
+#[test]
+fn exact_estimator_is_unbiased_with_circular_fov() {
+    let s = circle_scenario();
+    assert_unbiased(
+        &run_unbiasedness(
+            &s,
+            Reporting::WithHistory {
+                steps: 2,
+                moving: true,
+            },
+            12_000,
+        ),
+        "circle, 2 steps of history",
+    );
+}
+
+/// The check has power: reporting targets seen in the past without saying
+/// where the sensors were counts them twice, and the test sees it.
+#[test]
+fn withheld_history_is_detected_as_biased() {
+    let s = builtins().remove(0);
+    let e = run_unbiasedness(
+        &s,
+        Reporting::HistoryWithheld {
+            steps: 4,
+            moving: true,
+        },
+        6_000,
+    );
+    for &((k, t), m, se) in &e.results {
+        eprintln!(
+            "withheld: cell ({},{}) t={t}: {m:+.4} ± {se:.4}",
+            k.col, k.row
+        );
+    }
+    let worst = e
+        .results
+        .iter()
+        .map(|&(_, m, se)| -m / se)
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert!(
+        worst > 6.0,
+        "double counting went unnoticed (largest z = {worst:.1})"
+    );
+}
+
+fn snapshot_request(s: &Scenario, sensors: usize, seed: u64) -> PlanRequest {
+    use rand::RngExt;
+    let mut rng = StdRng::seed_from_u64(seed);
+    let world = World::stationary(s, &mut rng);
+    let sensors: Vec<SensorIn> = (0..sensors)
+        .map(|i| SensorIn {
+            id: Id::Number(i.into()),
+            x: rng.random::<f64>() * s.width,
+            y: rng.random::<f64>() * s.height,
+        })
+        .collect();
+    let fovs: Vec<Region> = sensors
+        .iter()
+        .map(|p| s.fov_region(s.snap(Point::new(p.x, p.y))))
+        .collect();
+    let targets = world
+        .in_zone(s)
+        .filter(|t| fovs.iter().any(|r| r.contains(t.pos)))
+        .map(|t| TargetIn {
+            id: None,
+            x: t.pos.x,
+            y: t.pos.y,
+            vx: t.vel.x,
+            vy: t.vel.y,
+        })
+        .collect();
+    PlanRequest {
+        sensors,
+        targets,
+        ..PlanRequest::default()
+    }
+}
+
+/// Iterated coordination never ends below priority, for either estimator,
+/// and priority is never below planning alone for the exact estimator.
+#[test]
+fn iterated_is_never_below_priority() {
+    let planners = [
+        Planner::new(builtins().remove(0)),
+        Planner::new(circle_scenario()),
+    ];
+    for planner in &planners {
+        for seed in 0..12u64 {
+            for estimator in [EstimatorKind::Exact, EstimatorKind::Paper] {
+                let mut req = snapshot_request(&planner.scenario, 4 + (seed as usize % 7), seed);
+                req.estimator = Some(estimator);
+                req.horizon = Some(1 + seed as usize % 4);
+                let total = |c: Coordination| {
+                    let mut r = req.clone();
+                    r.coordination = Some(c);
+                    planner.plan_request(&r).unwrap().expected_detections
+                };
+                let (none, priority, iterated) = (
+                    total(Coordination::None),
+                    total(Coordination::Priority),
+                    total(Coordination::Iterated),
+                );
+                let tol = 1e-9 * priority.abs().max(1.0);
+                assert!(
+                    iterated >= priority - tol,
+                    "{} seed {seed} {estimator:?}: iterated {iterated} < priority {priority}",
+                    planner.scenario.id
+                );
+                if estimator == EstimatorKind::Exact {
+                    assert!(
+                        priority >= none - tol,
+                        "seed {seed}: priority {priority} < none {none}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// For the exact estimator the total is the expected number of distinct
+/// targets detected: it equals the sum of marginals in any order, and with
+/// the whole zone observed and no sources it is the count of known targets
+/// the paths cover.
+#[test]
+fn exact_total_counts_distinct_known_targets() {
+    let mut spec = paper_spec(10.0);
+    for src in &mut spec.sources {
+        src.rate = 0.0;
+    }
+    let planner = Planner::new(Scenario::new(spec).unwrap());
+    // Two sensors side by side and three targets flying east through both.
+    let req = PlanRequest {
+        sensors: vec![
+            SensorIn {
+                id: Id::Text("a".into()),
+                x: 155.0,
+                y: 155.0,
+            },
+            SensorIn {
+                id: Id::Text("b".into()),
+                x: 165.0,
+                y: 155.0,
+            },
+        ],
+        targets: [(150.0, 150.0), (160.0, 160.0), (140.0, 170.0)]
+            .iter()
+            .map(|&(x, y)| TargetIn {
+                id: None,
+                x,
+                y,
+                vx: 1.0,
+                vy: 0.0,
+            })
+            .collect(),
+        horizon: Some(2),
+        ..PlanRequest::default()
+    };
+    for c in [
+        Coordination::None,
+        Coordination::Priority,
+        Coordination::Iterated,
+    ] {
+        let mut r = req.clone();
+        r.coordination = Some(c);
+        let resp = planner.plan_request(&r).unwrap();
+        // Every target stays within reach of both sensors: 3 per step.
+        assert_eq!(resp.expected_by_step, vec![3.0, 3.0], "{c:?}");
+    }
+    let resp = planner.plan_request(&req).unwrap();
+    let plan_b = &resp.plans[1];
+    // Under priority the second sensor sees nothing the first does not.
+    assert_eq!(plan_b.expected_detections, 0.0);
+}
