@@ -21,7 +21,7 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::estimator::Estimator;
+use crate::estimator::{Estimator, for_reach};
 use crate::geometry::Region;
 use crate::scenario::{Cell, Scenario};
 use crate::search::{BestPath, ValueGrid, best_path};
@@ -78,7 +78,7 @@ pub fn coordinate(
     // Every sensor alone.
     let mut plans: Vec<SensorPlan> = (0..n)
         .into_par_iter()
-        .map(|i| search(s, starts[i], horizon, |k, t| est.value(i, k, t, &[])))
+        .map(|i| search(starts[i], horizon, |t, g| est.fill(i, starts[i], t, &[], g)))
         .collect();
     let mut order: Vec<usize> = (0..n).collect();
     // Stable sort: ties keep request order.
@@ -91,8 +91,8 @@ pub fn coordinate(
             let above = &order[..rank];
             let plan = {
                 let fovs = fovs_by_step(s, &plans, above, horizon, starts[i]);
-                search(s, starts[i], horizon, |k, t| {
-                    est.value(i, k, t, &fovs[t - 1])
+                search(starts[i], horizon, |t, g| {
+                    est.fill(i, starts[i], t, &fovs[t - 1], g)
                 })
             };
             plans[i] = plan;
@@ -108,12 +108,14 @@ pub fn coordinate(
                 let grid_plan = if est.order_independent() {
                     let others: Vec<usize> = order.iter().copied().filter(|&j| j != i).collect();
                     let fovs = fovs_by_step(s, &plans, &others, horizon, starts[i]);
-                    search(s, starts[i], horizon, |k, t| {
-                        est.value(i, k, t, &fovs[t - 1])
+                    search(starts[i], horizon, |t, g| {
+                        est.fill(i, starts[i], t, &fovs[t - 1], g)
                     })
                 } else {
-                    search(s, starts[i], horizon, |k, t| {
-                        total_change(s, est, &plans, &order, rank, k, t)
+                    search(starts[i], horizon, |t, g| {
+                        for_reach(s, starts[i], t, |dc, dr, k| {
+                            g.set(t, dc, dr, total_change(s, est, &plans, &order, rank, k, t));
+                        });
                     })
                 };
                 let current = path_moves(starts[i], &plans[i].path);
@@ -246,28 +248,11 @@ fn path_moves(start: Cell, path: &[Cell]) -> Vec<(i32, i32)> {
         .collect()
 }
 
-/// Fills a value grid from `value(k, t)` over the reachable on-lattice cells
-/// and searches it.
-fn search(
-    s: &Scenario,
-    start: Cell,
-    horizon: usize,
-    value: impl Fn(Cell, usize) -> f64,
-) -> SensorPlan {
+/// Fills a value grid step by step with `fill(t, grid)` and searches it.
+fn search(start: Cell, horizon: usize, mut fill: impl FnMut(usize, &mut ValueGrid)) -> SensorPlan {
     let mut grid = ValueGrid::new(horizon);
     for t in 1..=horizon {
-        let ti = t as i32;
-        for dr in -ti..=ti {
-            for dc in -ti..=ti {
-                let k = Cell {
-                    col: start.col + dc,
-                    row: start.row + dr,
-                };
-                if s.on_lattice(k) {
-                    grid.set(t, dc, dr, value(k, t));
-                }
-            }
-        }
+        fill(t, &mut grid);
     }
     let BestPath { moves, value } = best_path(&grid);
     let mut c = start;

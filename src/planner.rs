@@ -9,7 +9,9 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use crate::coordination::{Coordination, coordinate};
-use crate::estimator::{Estimator, ExactEstimator, PaperEstimator, SourceRays, Target};
+use crate::estimator::{
+    ElementaryGrid, Estimator, ExactEstimator, PaperEstimator, SourceRays, Target,
+};
 use crate::geometry::{Point, Region};
 use crate::scenario::{Cell, Scenario, ValidationError, check_horizon};
 use crate::stats::Stats;
@@ -318,6 +320,7 @@ pub struct Planner {
     /// Its per-cell statistics.
     pub stats: Stats,
     rays: Vec<SourceRays>,
+    grid: Option<ElementaryGrid>,
     /// Time the precomputation took, milliseconds.
     pub precompute_ms: f64,
 }
@@ -328,10 +331,12 @@ impl Planner {
         let started = Instant::now();
         let stats = Stats::compute(&scenario);
         let rays = SourceRays::for_scenario(&scenario);
+        let grid = ElementaryGrid::new(&scenario);
         Planner {
             scenario,
             stats,
             rays,
+            grid,
             precompute_ms: started.elapsed().as_secs_f64() * 1e3,
         }
     }
@@ -351,6 +356,7 @@ impl Planner {
                 &self.stats,
                 &input.starts,
                 &input.targets,
+                input.horizon,
             )),
             EstimatorKind::Exact => {
                 let observed = self.observed_regions(input);
@@ -358,8 +364,11 @@ impl Planner {
                     s,
                     &self.stats,
                     &self.rays,
+                    self.grid.as_ref(),
                     &observed,
                     &input.targets,
+                    &input.starts,
+                    input.horizon,
                 ))
             }
         };

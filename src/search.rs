@@ -167,7 +167,7 @@ pub fn best_path(grid: &ValueGrid) -> BestPath {
     }
     let (mut c, mut r) = (0, 0);
     let mut moves = Vec::with_capacity(grid.horizon);
-    for t in 1..=grid.horizon {
+    for (t, best_t) in best.iter().enumerate().skip(1) {
         let mut choice = (0, 0);
         let mut top = f64::NEG_INFINITY;
         for &(mc, mr) in &MOVES {
@@ -175,7 +175,7 @@ pub fn best_path(grid: &ValueGrid) -> BestPath {
             if nc.abs() > t as i32 || nr.abs() > t as i32 {
                 continue;
             }
-            let b = best[t][idx(nc, nr)];
+            let b = best_t[idx(nc, nr)];
             if b > top {
                 top = b;
                 choice = (mc, mr);

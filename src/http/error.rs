@@ -1,0 +1,161 @@
+//! The API's one error type, rendered as RFC 9457 problem details
+//! (`application/problem+json`).
+
+use axum::Json;
+use axum::extract::rejection::{JsonRejection, PathRejection};
+use axum::http::{HeaderValue, StatusCode, header};
+use axum::response::{IntoResponse, Response};
+use serde::{Deserialize, Serialize};
+
+use crate::scenario::ValidationError;
+
+/// Media type of error bodies.
+pub const PROBLEM_JSON: &str = "application/problem+json";
+
+/// Base of the `type` URIs of our problems.
+const PROBLEM_BASE: &str = "https://vigil.dev/problems/";
+
+/// Everything a handler can fail with. Each variant maps to one status code
+/// and one problem `type`.
+#[derive(Debug, thiserror::Error)]
+pub enum ApiError {
+    /// The request body is not acceptable JSON for the endpoint (syntax
+    /// error, wrong or missing `Content-Type`, missing field, wrong type). 400.
+    #[error("{0}")]
+    MalformedBody(String),
+    /// A path parameter could not be decoded. 400.
+    #[error("{0}")]
+    BadPath(String),
+    /// The request body exceeds the size limit. 413.
+    #[error("{0}")]
+    PayloadTooLarge(String),
+    /// No scenario has this id. 404.
+    #[error("no scenario with id `{0}`")]
+    ScenarioNotFound(String),
+    /// No route matches the path. 404.
+    #[error("no resource at `{0}`")]
+    RouteNotFound(String),
+    /// The route exists but not for this method. 405.
+    #[error("method {method} is not allowed on `{path}`")]
+    MethodNotAllowed {
+        /// The method used.
+        method: String,
+        /// The request path.
+        path: String,
+    },
+    /// A built-in scenario cannot be deleted. 409.
+    #[error("scenario `{0}` is built in and cannot be deleted")]
+    BuiltinScenario(String),
+    /// A value of the request is outside its bounds. 422.
+    #[error(transparent)]
+    Validation(#[from] ValidationError),
+    /// A bug: a background task failed or a response could not be built. 500.
+    #[error("internal error: {0}")]
+    Internal(String),
+}
+
+/// The body of an error response (RFC 9457).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Problem {
+    /// URI identifying the kind of problem.
+    #[serde(rename = "type")]
+    pub kind: String,
+    /// Short summary of the kind of problem.
+    pub title: String,
+    /// HTTP status code.
+    pub status: u16,
+    /// What went wrong with this request.
+    pub detail: String,
+}
+
+impl ApiError {
+    /// HTTP status of this error.
+    pub fn status(&self) -> StatusCode {
+        match self {
+            ApiError::MalformedBody(_) | ApiError::BadPath(_) => StatusCode::BAD_REQUEST,
+            ApiError::PayloadTooLarge(_) => StatusCode::PAYLOAD_TOO_LARGE,
+            ApiError::ScenarioNotFound(_) | ApiError::RouteNotFound(_) => StatusCode::NOT_FOUND,
+            ApiError::MethodNotAllowed { .. } => StatusCode::METHOD_NOT_ALLOWED,
+            ApiError::BuiltinScenario(_) => StatusCode::CONFLICT,
+            ApiError::Validation(_) => StatusCode::UNPROCESSABLE_ENTITY,
+            ApiError::Internal(_) => StatusCode::INTERNAL_SERVER_ERROR,
+        }
+    }
+
+    /// Last segment of the problem `type` URI, and the title.
+    fn kind(&self) -> (&'static str, &'static str) {
+        match self {
+            ApiError::MalformedBody(_) => ("malformed-body", "Malformed request body"),
+            ApiError::BadPath(_) => ("bad-path", "Invalid path parameter"),
+            ApiError::PayloadTooLarge(_) => ("payload-too-large", "Request body too large"),
+            ApiError::ScenarioNotFound(_) => ("scenario-not-found", "Scenario not found"),
+            ApiError::RouteNotFound(_) => ("not-found", "Not found"),
+            ApiError::MethodNotAllowed { .. } => ("method-not-allowed", "Method not allowed"),
+            ApiError::BuiltinScenario(_) => ("builtin-scenario", "Built-in scenario"),
+            ApiError::Validation(_) => ("validation", "Invalid request"),
+            ApiError::Internal(_) => ("internal", "Internal server error"),
+        }
+    }
+
+    /// The problem details of this error.
+    pub fn problem(&self) -> Problem {
+        let (slug, title) = self.kind();
+        let status = self.status();
+        let detail = match self {
+            // Do not leak internals to clients; they are logged instead.
+            ApiError::Internal(_) => "the server failed to handle the request".to_owned(),
+            other => other.to_string(),
+        };
+        Problem {
+            kind: format!("{PROBLEM_BASE}{slug}"),
+            title: title.to_owned(),
+            status: status.as_u16(),
+            detail,
+        }
+    }
+}
+
+impl IntoResponse for ApiError {
+    fn into_response(self) -> Response {
+        let status = self.status();
+        if status.is_server_error() {
+            tracing::error!(error = %self, "request failed");
+        }
+        let mut res = (status, Json(self.problem())).into_response();
+        res.headers_mut()
+            .insert(header::CONTENT_TYPE, HeaderValue::from_static(PROBLEM_JSON));
+        res
+    }
+}
+
+impl From<JsonRejection> for ApiError {
+    fn from(rejection: JsonRejection) -> Self {
+        match rejection {
+            JsonRejection::JsonDataError(e) => ApiError::MalformedBody(e.body_text()),
+            JsonRejection::JsonSyntaxError(e) => ApiError::MalformedBody(e.body_text()),
+            JsonRejection::MissingJsonContentType(_) => ApiError::MalformedBody(
+                "expected a request with `Content-Type: application/json`".to_owned(),
+            ),
+            other if other.status() == StatusCode::PAYLOAD_TOO_LARGE => {
+                ApiError::PayloadTooLarge(other.body_text())
+            }
+            other => ApiError::MalformedBody(other.body_text()),
+        }
+    }
+}
+
+impl From<PathRejection> for ApiError {
+    fn from(rejection: PathRejection) -> Self {
+        if rejection.status().is_server_error() {
+            ApiError::Internal(rejection.body_text())
+        } else {
+            ApiError::BadPath(rejection.body_text())
+        }
+    }
+}
+
+impl From<tokio::task::JoinError> for ApiError {
+    fn from(e: tokio::task::JoinError) -> Self {
+        ApiError::Internal(format!("background task failed: {e}"))
+    }
+}

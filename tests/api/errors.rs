@@ -1,0 +1,328 @@
+//! Every error over the socket: status, `application/problem+json`, and a
+//! detail naming the offending field.
+
+use reqwest::{StatusCode, header};
+use serde_json::{Value, json};
+
+use crate::helpers::{
+    TestApp, assert_problem, assert_validation, plan_request, small_spec, spawn_app,
+};
+
+#[tokio::test]
+async fn malformed_json_is_400() {
+    let app = spawn_app().await;
+    for path in ["/v1/scenarios", "/v1/scenarios/paper-v10/plan"] {
+        for body in [
+            &b"{"[..],
+            b"{\"sensors\": [",
+            b"not json",
+            b"",
+            b"{} trailing",
+        ] {
+            let res = app
+                .post_raw(path, Some("application/json"), body.to_vec())
+                .await;
+            assert_problem(res, StatusCode::BAD_REQUEST, "JSON").await;
+        }
+        // Missing or wrong content type.
+        let valid = serde_json::to_vec(&plan_request()).unwrap();
+        let res = app.post_raw(path, None, valid.clone()).await;
+        assert_problem(res, StatusCode::BAD_REQUEST, "Content-Type").await;
+        let res = app.post_raw(path, Some("text/plain"), valid).await;
+        assert_problem(res, StatusCode::BAD_REQUEST, "Content-Type").await;
+    }
+}
+
+#[tokio::test]
+async fn missing_fields_and_wrong_types_are_400() {
+    let app = spawn_app().await;
+    let cases: [(&str, Value, &str); 7] = [
+        ("/v1/scenarios/paper-v10/plan", json!({}), "sensors"),
+        (
+            "/v1/scenarios/paper-v10/plan",
+            json!({"sensors": [{"id": 1, "x": 5.0}]}),
+            "y",
+        ),
+        (
+            "/v1/scenarios/paper-v10/plan",
+            json!({"sensors": "three"}),
+            "sensors",
+        ),
+        (
+            "/v1/scenarios/paper-v10/plan",
+            json!({"sensors": [], "horizon": -1}),
+            "horizon",
+        ),
+        (
+            "/v1/scenarios/paper-v10/plan",
+            json!({"sensors": [], "estimator": "magic"}),
+            "estimator",
+        ),
+        (
+            "/v1/scenarios",
+            json!({"zone": {"width": 1.0, "height": 1.0}}),
+            "cell_size",
+        ),
+        ("/v1/scenarios", json!({"zone": 1}), "zone"),
+    ];
+    for (path, body, field) in cases {
+        let res = app.post_json(path, &body).await;
+        assert_problem(res, StatusCode::BAD_REQUEST, field).await;
+    }
+    // Unknown fields are rejected too.
+    let mut spec = small_spec();
+    spec["colour"] = json!("red");
+    let res = app.post_json("/v1/scenarios", &spec).await;
+    assert_problem(res, StatusCode::BAD_REQUEST, "colour").await;
+}
+
+#[tokio::test]
+async fn unknown_scenario_is_404() {
+    let app = spawn_app().await;
+    let id = "s-0000000000000000";
+    let res = app.get(&format!("/v1/scenarios/{id}")).await;
+    assert_problem(res, StatusCode::NOT_FOUND, id).await;
+    let res = app.get(&format!("/v1/scenarios/{id}/stats")).await;
+    assert_problem(res, StatusCode::NOT_FOUND, id).await;
+    let res = app.delete(&format!("/v1/scenarios/{id}")).await;
+    assert_problem(res, StatusCode::NOT_FOUND, id).await;
+    let res = app
+        .post_json(&format!("/v1/scenarios/{id}/plan"), &plan_request())
+        .await;
+    assert_problem(res, StatusCode::NOT_FOUND, id).await;
+    // The scenario is looked up before the body is read.
+    let res = app
+        .post_raw(&format!("/v1/scenarios/{id}/plan"), None, b"{".to_vec())
+        .await;
+    assert_problem(res, StatusCode::NOT_FOUND, id).await;
+}
+
+#[tokio::test]
+async fn unknown_routes_and_methods_are_problems() {
+    let app = spawn_app().await;
+    for path in [
+        "/",
+        "/v2/scenarios",
+        "/v1/scenarios/paper-v10/nope",
+        "/v1/scenarios/",
+    ] {
+        let res = app.get(path).await;
+        assert_problem(res, StatusCode::NOT_FOUND, path).await;
+    }
+    let res = app.delete("/healthz").await;
+    assert_problem(res, StatusCode::METHOD_NOT_ALLOWED, "DELETE").await;
+    let res = app.get("/v1/scenarios/paper-v10/plan").await;
+    let allow = res
+        .headers()
+        .get(header::ALLOW)
+        .map(|v| v.to_str().unwrap().to_owned());
+    assert_problem(res, StatusCode::METHOD_NOT_ALLOWED, "GET").await;
+    assert_eq!(allow.as_deref(), Some("POST"));
+    let res = app
+        .client
+        .put(app.url("/v1/scenarios/paper-v10"))
+        .json(&json!({}))
+        .send()
+        .await
+        .unwrap();
+    assert_problem(res, StatusCode::METHOD_NOT_ALLOWED, "PUT").await;
+    // A path parameter that is not UTF-8.
+    let res = app.get("/v1/scenarios/%FF").await;
+    assert_problem(res, StatusCode::BAD_REQUEST, "UTF-8").await;
+}
+
+#[tokio::test]
+async fn oversized_body_is_413() {
+    let app = spawn_app().await;
+    let body = vec![b' '; 9 * 1024 * 1024];
+    let res = app
+        .post_raw(
+            "/v1/scenarios/paper-v10/plan",
+            Some("application/json"),
+            body,
+        )
+        .await;
+    assert_problem(res, StatusCode::PAYLOAD_TOO_LARGE, "").await;
+}
+
+/// POSTs `small_spec()` changed by `edit` and expects a 422 naming `field`.
+async fn spec_rejected(app: &TestApp, edit: impl FnOnce(&mut Value), field: &str) {
+    let mut spec = small_spec();
+    edit(&mut spec);
+    let res = app.post_json("/v1/scenarios", &spec).await;
+    assert_validation(res, field).await;
+}
+
+#[tokio::test]
+async fn invalid_specs_are_422() {
+    let app = spawn_app().await;
+    spec_rejected(
+        &app,
+        |s| s["sources"][0] = json!({"x": 50.0, "y": 50.0, "rate": 1.0}),
+        "sources[0]",
+    )
+    .await;
+    spec_rejected(
+        &app,
+        |s| s["sources"][1] = json!({"x": 0.0, "y": 100.0, "rate": 1.0}),
+        "sources[1]",
+    )
+    .await;
+    spec_rejected(
+        &app,
+        |s| s["sources"][0] = json!({"x": -1.0, "y": -1.0, "rate": 1.0}),
+        "sources[0].heading",
+    )
+    .await;
+    spec_rejected(
+        &app,
+        |s| s["sources"][0]["heading"] = json!("west"),
+        "sources[0].heading",
+    )
+    .await;
+    spec_rejected(&app, |s| s["cell_size"] = json!(7.0), "zone.width").await;
+    spec_rejected(&app, |s| s["zone"]["height"] = json!(95.0), "zone.height").await;
+    spec_rejected(&app, |s| s["zone"]["width"] = json!(0.0), "zone.width").await;
+    spec_rejected(&app, |s| s["zone"]["height"] = json!(-100.0), "zone.height").await;
+    spec_rejected(&app, |s| s["cell_size"] = json!(0.0), "cell_size").await;
+    spec_rejected(&app, |s| s["cell_size"] = json!(-10.0), "cell_size").await;
+    spec_rejected(
+        &app,
+        |s| s["fov"]["half_width"] = json!(0.0),
+        "fov.half_width",
+    )
+    .await;
+    spec_rejected(
+        &app,
+        |s| s["fov"] = json!({"shape": "circle", "radius": -1.0}),
+        "fov.radius",
+    )
+    .await;
+    spec_rejected(&app, |s| s["target_speed"] = json!(0.0), "target_speed").await;
+    spec_rejected(&app, |s| s["target_speed"] = json!(-5.0), "target_speed").await;
+    spec_rejected(
+        &app,
+        |s| s["sources"][1]["rate"] = json!(-0.1),
+        "sources[1].rate",
+    )
+    .await;
+    spec_rejected(&app, |s| s["horizon"] = json!(0), "horizon").await;
+    spec_rejected(&app, |s| s["horizon"] = json!(13), "horizon").await;
+    spec_rejected(&app, |s| s["name"] = json!("n".repeat(201)), "name").await;
+    spec_rejected(
+        &app,
+        |s| s["sources"] = json!(vec![json!({"x": -1.0, "y": 50.0, "rate": 0.1}); 65]),
+        "sources",
+    )
+    .await;
+    // 2001 × 2000 = 4 002 000 cells.
+    spec_rejected(
+        &app,
+        |s| {
+            s["zone"] = json!({"width": 2001.0, "height": 2000.0});
+            s["cell_size"] = json!(1.0);
+        },
+        "cell_size",
+    )
+    .await;
+    spec_rejected(
+        &app,
+        |s| {
+            s["zone"] = json!({"width": 5e6, "height": 1.0});
+            s["cell_size"] = json!(1.0);
+        },
+        "zone.width",
+    )
+    .await;
+    spec_rejected(&app, |s| s["cell_size"] = json!(1e-300), "zone.width").await;
+    // Bounds are inclusive: 64 sources and horizon 12 are fine.
+    let mut spec = small_spec();
+    spec["sources"] = json!(vec![json!({"x": -1.0, "y": 50.0, "rate": 0.1}); 64]);
+    spec["horizon"] = json!(12);
+    let res = app.post_json("/v1/scenarios", &spec).await;
+    assert_eq!(res.status(), StatusCode::CREATED);
+    // Nothing invalid was registered.
+    let list: Value = app.get("/v1/scenarios").await.json().await.unwrap();
+    assert_eq!(list["scenarios"].as_array().unwrap().len(), 3);
+}
+
+/// POSTs `plan_request()` changed by `edit` to paper-v10 and expects a 422
+/// naming `field`.
+async fn plan_rejected(app: &TestApp, edit: impl FnOnce(&mut Value), field: &str) {
+    let mut req = plan_request();
+    edit(&mut req);
+    let res = app.plan(&req).await;
+    assert_validation(res, field).await;
+}
+
+fn sensors(n: usize) -> Value {
+    (0..n)
+        .map(|i| json!({"id": i, "x": (i % 300) as f64, "y": (i / 300) as f64}))
+        .collect()
+}
+
+fn positions(n: usize) -> Value {
+    (0..n)
+        .map(|i| json!({"x": (i % 300) as f64, "y": 1.0}))
+        .collect()
+}
+
+#[tokio::test]
+async fn invalid_plan_requests_are_422() {
+    let app = spawn_app().await;
+    plan_rejected(&app, |r| r["sensors"][1]["x"] = json!(300.5), "sensors[1]").await;
+    plan_rejected(&app, |r| r["sensors"][2]["y"] = json!(-0.1), "sensors[2]").await;
+    plan_rejected(
+        &app,
+        |r| r["sensors"][2]["id"] = json!("a"),
+        "sensors[2].id",
+    )
+    .await;
+    plan_rejected(&app, |r| r["sensors"][2]["id"] = json!(7), "sensors[2].id").await;
+    plan_rejected(&app, |r| r["sensors"] = json!([]), "sensors").await;
+    plan_rejected(&app, |r| r["sensors"] = sensors(257), "sensors").await;
+    plan_rejected(&app, |r| r["horizon"] = json!(0), "horizon").await;
+    plan_rejected(&app, |r| r["horizon"] = json!(13), "horizon").await;
+    plan_rejected(
+        &app,
+        |r| {
+            r["targets"] = json!(vec![
+                json!({"x": 150.0, "y": 150.0, "vx": 1.0, "vy": 0.0});
+                20_001
+            ])
+        },
+        "targets",
+    )
+    .await;
+    plan_rejected(
+        &app,
+        |r| r["history"] = json!(vec![positions(3); 33]),
+        "history",
+    )
+    .await;
+    plan_rejected(
+        &app,
+        |r| r["history"] = json!([positions(3), positions(257)]),
+        "history[1]",
+    )
+    .await;
+    plan_rejected(
+        &app,
+        |r| r["history"] = json!([[{"x": 400.0, "y": 1.0}]]),
+        "history[0][0]",
+    )
+    .await;
+    // Bounds are inclusive: 32 history steps, 256 positions in one. (256
+    // sensors are not planned here: that takes seconds.)
+    let mut req = plan_request();
+    let mut history = vec![positions(3); 32];
+    history[0] = positions(256);
+    req["history"] = json!(history);
+    let res = app.plan(&req).await;
+    assert_eq!(
+        res.status(),
+        StatusCode::OK,
+        "{}",
+        res.text().await.unwrap()
+    );
+}

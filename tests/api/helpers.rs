@@ -1,0 +1,161 @@
+//! Spawning the app and common assertions.
+
+use reqwest::{Response, StatusCode, header};
+use serde_json::{Value, json};
+use tokio::net::TcpListener;
+use vigil::http::{AppState, router};
+
+/// A running server and a client for it.
+pub struct TestApp {
+    /// Base URL, e.g. `http://127.0.0.1:43127`.
+    pub address: String,
+    /// HTTP client.
+    pub client: reqwest::Client,
+}
+
+/// Starts the app on `127.0.0.1:0` in the background of the test's runtime.
+pub async fn spawn_app() -> TestApp {
+    let listener = TcpListener::bind("127.0.0.1:0").await.unwrap();
+    let addr = listener.local_addr().unwrap();
+    let state = tokio::task::spawn_blocking(AppState::new).await.unwrap();
+    tokio::spawn(async move {
+        axum::serve(listener, router(state)).await.unwrap();
+    });
+    TestApp {
+        address: format!("http://{addr}"),
+        client: reqwest::Client::new(),
+    }
+}
+
+impl TestApp {
+    pub fn url(&self, path: &str) -> String {
+        format!("{}{path}", self.address)
+    }
+
+    pub async fn get(&self, path: &str) -> Response {
+        self.client.get(self.url(path)).send().await.unwrap()
+    }
+
+    pub async fn delete(&self, path: &str) -> Response {
+        self.client.delete(self.url(path)).send().await.unwrap()
+    }
+
+    pub async fn post_json(&self, path: &str, body: &Value) -> Response {
+        self.client
+            .post(self.url(path))
+            .json(body)
+            .send()
+            .await
+            .unwrap()
+    }
+
+    /// POSTs raw bytes with the given content type (none if `None`).
+    pub async fn post_raw(
+        &self,
+        path: &str,
+        content_type: Option<&str>,
+        body: Vec<u8>,
+    ) -> Response {
+        let mut req = self.client.post(self.url(path)).body(body);
+        if let Some(ct) = content_type {
+            req = req.header(header::CONTENT_TYPE, ct);
+        }
+        req.send().await.unwrap()
+    }
+
+    /// POSTs a plan request to `paper-v10`.
+    pub async fn plan(&self, body: &Value) -> Response {
+        self.post_json("/v1/scenarios/paper-v10/plan", body).await
+    }
+}
+
+/// Reads a JSON body after checking the status and content type.
+pub async fn json_body(res: Response, status: StatusCode) -> Value {
+    let got = res.status();
+    let ct = content_type(&res);
+    let text = res.text().await.unwrap();
+    assert_eq!(got, status, "body: {text}");
+    assert_eq!(ct, "application/json", "body: {text}");
+    serde_json::from_str(&text).unwrap()
+}
+
+/// Checks a problem+json error: status, content type, the four members, and
+/// that `detail` mentions `mentions`. Returns the body.
+pub async fn assert_problem(res: Response, status: StatusCode, mentions: &str) -> Value {
+    let got = res.status();
+    let ct = content_type(&res);
+    let text = res.text().await.unwrap();
+    assert_eq!(got, status, "body: {text}");
+    assert_eq!(ct, "application/problem+json", "body: {text}");
+    let body: Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(body["status"], json!(status.as_u16()), "body: {text}");
+    assert!(
+        body["type"].as_str().is_some_and(|t| !t.is_empty()),
+        "body: {text}"
+    );
+    assert!(
+        body["title"].as_str().is_some_and(|t| !t.is_empty()),
+        "body: {text}"
+    );
+    let detail = body["detail"].as_str().unwrap();
+    assert!(
+        detail.contains(mentions),
+        "detail {detail:?} does not mention {mentions:?}"
+    );
+    body
+}
+
+/// A 422 naming `field` in its detail, with the validation problem type.
+pub async fn assert_validation(res: Response, field: &str) {
+    let body = assert_problem(res, StatusCode::UNPROCESSABLE_ENTITY, field).await;
+    let detail = body["detail"].as_str().unwrap();
+    assert!(
+        detail.starts_with(&format!("{field}: ")),
+        "detail {detail:?} should start with the field {field:?}"
+    );
+    assert!(body["type"].as_str().unwrap().ends_with("/validation"));
+}
+
+fn content_type(res: &Response) -> String {
+    res.headers()
+        .get(header::CONTENT_TYPE)
+        .map(|v| v.to_str().unwrap().to_owned())
+        .unwrap_or_default()
+}
+
+/// A small valid scenario spec: a 100×100 zone of 10-unit cells, one source
+/// west of it.
+pub fn small_spec() -> Value {
+    json!({
+        "name": "small",
+        "zone": {"width": 100.0, "height": 100.0},
+        "cell_size": 10.0,
+        "fov": {"shape": "square", "half_width": 15.0},
+        "target_speed": 10.0,
+        "sources": [
+            {"x": -1.0, "y": 50.0, "rate": 0.5},
+            {"x": 50.0, "y": 101.0, "rate": 0.25}
+        ]
+    })
+}
+
+/// A valid plan request on `paper-v10`: three sensors, a few targets.
+pub fn plan_request() -> Value {
+    json!({
+        "sensors": [
+            {"id": "a", "x": 55.0, "y": 55.0},
+            {"id": 7, "x": 150.0, "y": 150.0},
+            {"id": "c", "x": 245.0, "y": 60.0}
+        ],
+        "targets": [
+            {"id": "t1", "x": 60.0, "y": 40.0, "vx": 10.0, "vy": 0.0},
+            {"x": 140.0, "y": 160.0, "vx": -3.0, "vy": 9.0},
+            {"id": 3, "x": 250.0, "y": 70.0, "vx": 0.0, "vy": -10.0}
+        ]
+    })
+}
+
+/// `a` and `b` agree within `rel` relative error.
+pub fn close(a: f64, b: f64, rel: f64) -> bool {
+    (a - b).abs() <= rel * a.abs().max(b.abs()).max(f64::MIN_POSITIVE)
+}
