@@ -282,7 +282,10 @@ impl Region {
                 // substitution makes the integrand smooth there.
                 let (x, w) = if curved {
                     let q = std::f64::consts::FRAC_PI_2 * n;
-                    (mid + half * q.sin(), wt * half * std::f64::consts::FRAC_PI_2 * q.cos())
+                    (
+                        mid + half * q.sin(),
+                        wt * half * std::f64::consts::FRAC_PI_2 * q.cos(),
+                    )
                 } else {
                     (mid + half * n, wt * half)
                 };
@@ -506,7 +509,11 @@ mod tests {
                 r: 1.0,
             }),
         };
-        assert!((d.area() - std::f64::consts::PI).abs() < 1e-6, "{}", d.area());
+        assert!(
+            (d.area() - std::f64::consts::PI).abs() < 1e-6,
+            "{}",
+            d.area()
+        );
         let o = Point::new(-5.0, 0.5);
         let dir = Point::new(1.0, 0.0);
         let inv = Point::new(1.0, f64::INFINITY);

@@ -360,7 +360,7 @@ impl Planner {
             )),
             EstimatorKind::Exact => {
                 let observed = self.observed_regions(input);
-                Box::new(ExactEstimator::new(
+                let est = ExactEstimator::new(
                     s,
                     &self.stats,
                     &self.rays,
@@ -369,7 +369,9 @@ impl Planner {
                     &input.targets,
                     &input.starts,
                     input.horizon,
-                ))
+                );
+                est.prepare();
+                Box::new(est)
             }
         };
         let result = coordinate(

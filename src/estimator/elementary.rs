@@ -28,6 +28,48 @@ pub struct ElementaryGrid {
     row_span: Vec<(usize, usize)>,
     /// `prefix[b·nx + a]`: stationary targets in `[0, xs[a]] × [0, ys[b]]`.
     prefix: Vec<f64>,
+    /// Lookup tables that find a coordinate's interval in O(1) on average:
+    /// bucket `i` of width `1/scale` holds the interval at its lower end.
+    x_buckets: Vec<u32>,
+    x_scale: f64,
+    y_buckets: Vec<u32>,
+    y_scale: f64,
+}
+
+/// Buckets over `[0, extent]`, two per interval on average.
+fn buckets(bp: &[f64]) -> (Vec<u32>, f64) {
+    let n = 2 * (bp.len() - 1);
+    let extent = bp[bp.len() - 1];
+    let scale = n as f64 / extent;
+    let mut j = 0;
+    let table = (0..=n)
+        .map(|i| {
+            let x = i as f64 / scale;
+            while j + 2 < bp.len() && bp[j + 1] <= x {
+                j += 1;
+            }
+            j as u32
+        })
+        .collect();
+    (table, scale)
+}
+
+#[inline]
+fn locate(bp: &[f64], table: &[u32], scale: f64, x: f64, dir: f64) -> usize {
+    let n = bp.len() - 1;
+    let slot = ((x * scale).max(0.0) as usize).min(table.len() - 1);
+    let mut i = table[slot] as usize;
+    while i + 1 < n && bp[i + 1] <= x {
+        i += 1;
+    }
+    while i > 0 && bp[i] > x {
+        i -= 1;
+    }
+    if dir < 0.0 && i > 0 && bp[i] == x {
+        i - 1
+    } else {
+        i
+    }
 }
 
 /// Antiderivative of `1/√(x²+y²)` valid on `x ≥ 0`, any `y`:
@@ -129,12 +171,18 @@ impl ElementaryGrid {
                 })
             })
             .collect();
+        let (x_buckets, x_scale) = buckets(&xs);
+        let (y_buckets, y_scale) = buckets(&ys);
         Some(ElementaryGrid {
             xs,
             ys,
             col_span,
             row_span,
             prefix,
+            x_buckets,
+            x_scale,
+            y_buckets,
+            y_scale,
         })
     }
 
@@ -159,17 +207,17 @@ impl ElementaryGrid {
         p(a1, b1) - p(a0, b1) - p(a1, b0) + p(a0, b0)
     }
 
-    /// Index of the x-interval holding `x`, moving in direction `dir`: on a
-    /// breakpoint, the interval the motion enters.
+    /// Index of the x-interval holding `x`, moving in direction `dir` (on a
+    /// breakpoint, the interval the motion enters).
     #[inline]
-    pub(crate) fn locate(bp: &[f64], x: f64, dir: f64) -> usize {
-        let n = bp.len() - 1;
-        let i = bp.partition_point(|&v| v <= x).saturating_sub(1).min(n - 1);
-        if dir < 0.0 && i > 0 && bp[i] == x {
-            i - 1
-        } else {
-            i
-        }
+    pub(crate) fn locate_x(&self, x: f64, dir: f64) -> usize {
+        locate(&self.xs, &self.x_buckets, self.x_scale, x, dir)
+    }
+
+    /// As [`ElementaryGrid::locate_x`], in y.
+    #[inline]
+    pub(crate) fn locate_y(&self, y: f64, dir: f64) -> usize {
+        locate(&self.ys, &self.y_buckets, self.y_scale, y, dir)
     }
 }
 
@@ -214,6 +262,30 @@ mod tests {
             let zone = grid.mass(0, nx, 0, ny);
             assert!((zone - stats.expected_targets_in_zone).abs() < 1e-9 * zone);
         }
+    }
+
+    #[test]
+    fn locate_finds_the_interval_entered() {
+        let mut spec = paper_spec(10.0);
+        spec.fov = FovSpec::Square { half_width: 23.0 };
+        let s = Scenario::new(spec).expect("valid");
+        let g = ElementaryGrid::new(&s).expect("square");
+        for i in 0..3000 {
+            let x = i as f64 * 0.1;
+            let slow =
+                g.xs.partition_point(|&v| v <= x)
+                    .saturating_sub(1)
+                    .min(g.xs.len() - 2);
+            assert_eq!(g.locate_x(x, 1.0), slow, "x = {x}");
+            let back = if slow > 0 && g.xs[slow] == x {
+                slow - 1
+            } else {
+                slow
+            };
+            assert_eq!(g.locate_x(x, -1.0), back, "x = {x}");
+        }
+        assert_eq!(g.locate_y(300.0, 1.0), g.ys.len() - 2);
+        assert_eq!(g.locate_y(-1e-12, 1.0), 0);
     }
 
     #[test]

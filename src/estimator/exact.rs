@@ -3,6 +3,8 @@
 
 use std::sync::OnceLock;
 
+use rayon::prelude::*;
+
 use super::elementary::ElementaryGrid;
 use super::{Estimator, Target, for_reach};
 use crate::geometry::{Point, Region, union_within};
@@ -71,40 +73,132 @@ impl SourceRays {
     }
 }
 
-/// A region seen `s` steps ago, as crossed by the rays of one source.
-struct Blob {
-    /// `v·s`: how far a target has flown since.
-    shift: f64,
-    first: usize,
-    /// Ray interval per ray from `first`; `(∞, −∞)` where the ray misses.
-    intervals: Vec<(f64, f64)>,
-    r_min: f64,
-    r_max: f64,
+/// Where the rays of one source crossed the observed regions: per ray, the
+/// intervals seen `s` steps ago, each already pushed by `v·s` (the distance a
+/// target has flown since). Stored compactly, ray by ray.
+struct RayHits {
+    /// `hits[offsets[m]..offsets[m+1]]` are ray `m`'s intervals.
+    offsets: Vec<usize>,
+    hits: Vec<(f64, f64)>,
 }
 
-impl Blob {
-    /// The blobs' intervals on ray `m`, pushed `lift` further, into `out`.
-    #[inline]
-    fn push_interval(&self, m: usize, lift: f64, out: &mut Vec<(f64, f64)>) {
-        if m >= self.first
-            && let Some(&(p, q)) = self.intervals.get(m - self.first)
-            && p <= q
-        {
-            let l = self.shift + lift;
-            out.push((p + l, q + l));
+impl RayHits {
+    fn new(sr: &SourceRays, observed: &[Vec<Region>], speed: f64) -> Self {
+        let mut buf = Vec::new();
+        let mut tagged: Vec<(usize, (f64, f64))> = Vec::new();
+        for (s, regions) in observed.iter().enumerate() {
+            let shift = speed * s as f64;
+            for region in regions {
+                let Some((a, b)) = sr.range(region, &mut buf) else {
+                    continue;
+                };
+                for m in a..b {
+                    let (d, inv) = sr.dirs[m];
+                    if let Some((p, q)) = region.ray(sr.source.pos, d, inv) {
+                        tagged.push((m, (p + shift, q + shift)));
+                    }
+                }
+            }
         }
+        // Counting sort by ray.
+        let mut offsets = vec![0; sr.dirs.len() + 1];
+        for &(m, _) in &tagged {
+            offsets[m + 1] += 1;
+        }
+        for m in 0..sr.dirs.len() {
+            offsets[m + 1] += offsets[m];
+        }
+        let mut next = offsets.clone();
+        let mut hits = vec![(0.0, 0.0); tagged.len()];
+        for (m, h) in tagged {
+            hits[next[m]] = h;
+            next[m] += 1;
+        }
+        RayHits { offsets, hits }
     }
 
-    fn may_reach(&self, a: usize, b: usize, lift: f64, (r0, r1): (f64, f64)) -> bool {
-        self.first < b
-            && self.first + self.intervals.len() > a
-            && self.r_min + self.shift + lift <= r1
-            && self.r_max + self.shift + lift >= r0
+    /// Ray `m`'s seen intervals at step `t`, pushed a further `lift = v·t`.
+    #[inline]
+    fn lifted(&self, m: usize, lift: f64) -> impl Iterator<Item = (f64, f64)> + '_ {
+        self.hits[self.offsets[m]..self.offsets[m + 1]]
+            .iter()
+            .map(move |&(p, q)| (p + lift, q + lift))
     }
 }
 
 /// A half-open block `[a0, a1) × [b0, b1)` of elementary rectangles.
 type Block = (usize, usize, usize, usize);
+
+/// Prefix sums over a block of rectangles.
+struct BlockSums {
+    a0: usize,
+    b0: usize,
+    w: usize,
+    prefix: Vec<f64>,
+}
+
+impl BlockSums {
+    /// The sum over a sub-block (global indices).
+    #[inline]
+    fn sum(&self, (a0, a1, b0, b1): Block) -> f64 {
+        let p = |a: usize, b: usize| self.prefix[(b - self.b0) * self.w + (a - self.a0)];
+        p(a1, b1) - p(a0, b1) - p(a1, b0) + p(a0, b0)
+    }
+}
+
+/// The windows of one step: one shared by every sensor when their reaches
+/// lie close together (each seen interval is walked once), otherwise one
+/// per sensor (memory bounded by the reaches on a large lattice).
+struct StepWindows {
+    blocks: Vec<Block>,
+    built: Vec<OnceLock<Window>>,
+    slot: Vec<usize>,
+}
+
+impl StepWindows {
+    fn new(grid: &ElementaryGrid, s: &Scenario, starts: &[Cell], t: usize) -> Self {
+        let ti = t as i32;
+        let reach: Vec<Block> = starts
+            .iter()
+            .map(|start| {
+                let lo = Cell {
+                    col: (start.col - ti).max(0),
+                    row: (start.row - ti).max(0),
+                };
+                let hi = Cell {
+                    col: (start.col + ti).min(s.cols - 1),
+                    row: (start.row + ti).min(s.rows - 1),
+                };
+                let (a0, _, b0, _) = grid.span(lo);
+                let (_, a1, _, b1) = grid.span(hi);
+                (a0, a1, b0, b1)
+            })
+            .collect();
+        let size = |b: &Block| (b.1 - b.0) * (b.3 - b.2);
+        let bbox = reach.iter().fold((usize::MAX, 0, usize::MAX, 0), |acc, b| {
+            (
+                acc.0.min(b.0),
+                acc.1.max(b.1),
+                acc.2.min(b.2),
+                acc.3.max(b.3),
+            )
+        });
+        let total: usize = reach.iter().map(size).sum();
+        if !reach.is_empty() && size(&bbox) <= (1 << 16).max(2 * total) {
+            Self {
+                blocks: vec![bbox],
+                built: vec![OnceLock::new()],
+                slot: vec![0; reach.len()],
+            }
+        } else {
+            Self {
+                built: reach.iter().map(|_| OnceLock::new()).collect(),
+                slot: (0..reach.len()).collect(),
+                blocks: reach,
+            }
+        }
+    }
+}
 
 /// `u_t(E)` over a block of elementary rectangles: the expected targets in
 /// each at step `t` that no sensor can have seen.
@@ -145,12 +239,13 @@ pub struct ExactEstimator<'a> {
     rays: &'a [SourceRays],
     grid: Option<&'a ElementaryGrid>,
     known: Vec<Target>,
-    /// Per source (aligned with `rays`), the observed regions.
-    blobs: Vec<Vec<Blob>>,
+    /// Per source (aligned with `rays`), where its rays crossed what was seen.
+    seen: Vec<RayHits>,
     /// Sensors' starts, whose windows the fast path uses.
     starts: Vec<Cell>,
-    /// Per sensor, per step 1..=T, built on first use (empty without a grid).
-    windows: Vec<Vec<OnceLock<Window>>>,
+    /// Per step 1..=T: the blocks to accumulate, the window of each (built
+    /// on first use), and which block serves each sensor.
+    windows: Vec<StepWindows>,
 }
 
 impl<'a> ExactEstimator<'a> {
@@ -170,36 +265,9 @@ impl<'a> ExactEstimator<'a> {
         starts: &[Cell],
         horizon: usize,
     ) -> Self {
-        let mut buf = Vec::new();
-        let blobs = rays
-            .iter()
-            .map(|sr| {
-                let mut out = Vec::new();
-                for (s, regions) in observed.iter().enumerate() {
-                    for region in regions {
-                        let Some((a, b)) = sr.range(region, &mut buf) else {
-                            continue;
-                        };
-                        let intervals = sr.dirs[a..b]
-                            .iter()
-                            .map(|&(d, inv)| {
-                                region
-                                    .ray(sr.source.pos, d, inv)
-                                    .unwrap_or((f64::INFINITY, f64::NEG_INFINITY))
-                            })
-                            .collect();
-                        let (r_min, r_max) = region.radial_bounds(sr.source.pos);
-                        out.push(Blob {
-                            shift: scenario.speed * s as f64,
-                            first: a,
-                            intervals,
-                            r_min,
-                            r_max,
-                        });
-                    }
-                }
-                out
-            })
+        let seen = rays
+            .par_iter()
+            .map(|sr| RayHits::new(sr, observed, scenario.speed))
             .collect();
         let grid = grid.filter(|_| matches!(scenario.fov, FovSpec::Square { .. }));
         Self {
@@ -212,26 +280,40 @@ impl<'a> ExactEstimator<'a> {
                 .copied()
                 .filter(|tg| scenario.in_zone(tg.pos))
                 .collect(),
-            blobs,
+            seen,
             starts: starts.to_vec(),
             windows: match grid {
-                Some(_) => starts
-                    .iter()
-                    .map(|_| (0..horizon).map(|_| OnceLock::new()).collect())
+                Some(grid) => (1..=horizon)
+                    .map(|t| StepWindows::new(grid, scenario, starts, t))
                     .collect(),
                 None => Vec::new(),
             },
         }
     }
 
-    /// The window of `sensor` at step `t`, if the fast path applies.
+    /// Builds every window now, in parallel (otherwise each is built on
+    /// first use).
+    pub fn prepare(&self) {
+        let Some(grid) = self.grid else { return };
+        let jobs: Vec<(usize, usize)> = self
+            .windows
+            .iter()
+            .enumerate()
+            .flat_map(|(t, w)| (0..w.blocks.len()).map(move |slot| (t, slot)))
+            .collect();
+        jobs.par_iter().for_each(|&(t, slot)| {
+            let step = &self.windows[t];
+            step.built[slot].get_or_init(|| self.window(grid, step.blocks[slot], t + 1));
+        });
+    }
+
+    /// The window serving `sensor` at step `t`, if the fast path applies.
     fn window_of(&self, sensor: usize, t: usize) -> Option<(&ElementaryGrid, &Window)> {
         let grid = self.grid?;
-        let cell = self.windows.get(sensor)?.get(t.checked_sub(1)?)?;
-        Some((
-            grid,
-            cell.get_or_init(|| self.window(grid, self.starts[sensor], t)),
-        ))
+        let step = self.windows.get(t.checked_sub(1)?)?;
+        let slot = *step.slot.get(sensor)?;
+        let win = step.built[slot].get_or_init(|| self.window(grid, step.blocks[slot], t));
+        Some((grid, win))
     }
 
     /// Known targets at step `t` inside `fk` and outside every excluded region.
@@ -245,21 +327,9 @@ impl<'a> ExactEstimator<'a> {
             .count() as f64
     }
 
-    /// The unseen mass of the elementary rectangles a sensor at `start` can
-    /// cover at step `t`.
-    fn window(&self, grid: &ElementaryGrid, start: Cell, t: usize) -> Window {
+    /// The unseen mass at step `t` of the elementary rectangles of a block.
+    fn window(&self, grid: &ElementaryGrid, (a0, a1, b0, b1): Block, t: usize) -> Window {
         let s = self.scenario;
-        let ti = t as i32;
-        let lo = Cell {
-            col: (start.col - ti).max(0),
-            row: (start.row - ti).max(0),
-        };
-        let hi = Cell {
-            col: (start.col + ti).min(s.cols - 1),
-            row: (start.row + ti).min(s.rows - 1),
-        };
-        let (a0, _, b0, _) = grid.span(lo);
-        let (_, a1, _, b1) = grid.span(hi);
         let (na, nb) = (a1 - a0, b1 - b0);
         let mut unseen = Vec::with_capacity(na * nb);
         for b in b0..b1 {
@@ -267,13 +337,6 @@ impl<'a> ExactEstimator<'a> {
                 unseen.push(grid.mass(a, a + 1, b, b + 1));
             }
         }
-        let mut win = Window {
-            a0,
-            b0,
-            na,
-            nb,
-            unseen,
-        };
         let rect = crate::geometry::Rect {
             x0: grid.xs[a0],
             y0: grid.ys[b0],
@@ -282,45 +345,68 @@ impl<'a> ExactEstimator<'a> {
         };
         let region = Region { rect, disk: None };
         let lift = s.speed * t as f64;
-        let mut buf = Vec::new();
-        let mut intervals = Vec::new();
-        for (sr, blobs) in self.rays.iter().zip(&self.blobs) {
-            let Some((ma, mb)) = sr.range(&region, &mut buf) else {
-                continue;
-            };
-            let radial = region.radial_bounds(sr.source.pos);
-            let cands: Vec<&Blob> = blobs
-                .iter()
-                .filter(|bl| bl.may_reach(ma, mb, lift, radial))
-                .collect();
-            if cands.is_empty() {
-                continue;
-            }
-            for m in ma..mb {
-                let (d, inv) = sr.dirs[m];
-                let Some((wa, wb)) = region.ray(sr.source.pos, d, inv) else {
-                    continue;
+        let block = (a0, a1, b0, b1);
+        // Each source accumulates into its own buffer, in parallel.
+        let seen_by_source: Vec<Vec<f64>> = self
+            .rays
+            .par_iter()
+            .zip(&self.seen)
+            .map(|(sr, seen)| {
+                let mut acc = vec![0.0; na * nb];
+                let mut buf = Vec::new();
+                let mut intervals = Vec::new();
+                let Some((ma, mb)) = sr.range(&region, &mut buf) else {
+                    return acc;
                 };
-                intervals.clear();
-                for bl in &cands {
-                    bl.push_interval(m, lift, &mut intervals);
-                }
-                if intervals.is_empty() {
-                    continue;
-                }
-                intervals.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-                // Walk the union of the seen intervals, clipped to the window.
-                let mut reach = wa;
-                for &(p, q) in &intervals {
-                    let (p, q) = (p.max(reach), q.min(wb));
-                    if q > p {
-                        walk(grid, &mut win, sr.source.pos, d, inv, p, q, sr.weight);
-                        reach = q;
+                for m in ma..mb {
+                    if seen.offsets[m] == seen.offsets[m + 1] {
+                        continue;
+                    }
+                    let (d, inv) = sr.dirs[m];
+                    let Some((wa, wb)) = region.ray(sr.source.pos, d, inv) else {
+                        continue;
+                    };
+                    intervals.clear();
+                    intervals.extend(seen.lifted(m, lift).filter(|&(p, q)| q > wa && p < wb));
+                    if intervals.is_empty() {
+                        continue;
+                    }
+                    intervals.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+                    // Walk the union of the seen intervals, clipped to the block.
+                    let mut reach = wa;
+                    for &(p, q) in &intervals {
+                        let (p, q) = (p.max(reach), q.min(wb));
+                        if q > p {
+                            walk(
+                                grid,
+                                block,
+                                &mut acc,
+                                sr.source.pos,
+                                d,
+                                inv,
+                                p,
+                                q,
+                                sr.weight,
+                            );
+                            reach = q;
+                        }
                     }
                 }
+                acc
+            })
+            .collect();
+        for acc in &seen_by_source {
+            for (u, s) in unseen.iter_mut().zip(acc) {
+                *u += s;
             }
         }
-        win
+        Window {
+            a0,
+            b0,
+            na,
+            nb,
+            unseen,
+        }
     }
 
     /// `U` by integrating every ray that crosses `fk` (the general path).
@@ -329,28 +415,21 @@ impl<'a> ExactEstimator<'a> {
         let mut intervals: Vec<(f64, f64)> = Vec::new();
         let lift = self.scenario.speed * t as f64;
         let mut seen = 0.0;
-        for (sr, blobs) in self.rays.iter().zip(&self.blobs) {
+        for (sr, hits) in self.rays.iter().zip(&self.seen) {
             let Some((a, b)) = sr.range(fk, &mut buf) else {
                 continue;
             };
-            let radial = fk.radial_bounds(sr.source.pos);
-            let cands: Vec<&Blob> = blobs
-                .iter()
-                .filter(|bl| bl.may_reach(a, b, lift, radial))
-                .collect();
-            if cands.is_empty() && excluded.is_empty() {
-                continue;
-            }
             let mut sum = 0.0;
             for m in a..b {
+                if excluded.is_empty() && hits.offsets[m] == hits.offsets[m + 1] {
+                    continue;
+                }
                 let (d, inv) = sr.dirs[m];
                 let Some((lo, hi)) = fk.ray(sr.source.pos, d, inv) else {
                     continue;
                 };
                 intervals.clear();
-                for bl in &cands {
-                    bl.push_interval(m, lift, &mut intervals);
-                }
+                intervals.extend(hits.lifted(m, lift).filter(|&(p, q)| q > lo && p < hi));
                 for x in excluded {
                     if let Some(iv) = x.ray(sr.source.pos, d, inv) {
                         intervals.push(iv);
@@ -375,44 +454,60 @@ impl<'a> ExactEstimator<'a> {
         self.known_in(&fk, t, &excluded) + self.unseen_by_rays(k, &fk, t, &excluded)
     }
 
-    /// The sensor's window at step `t` and `k`'s block relative to it, when
-    /// the fast path applies.
-    fn block(&self, sensor: usize, k: Cell, t: usize) -> Option<(&Window, Block)> {
+    /// The sensor's window at step `t`, when it holds `k`'s block.
+    fn block(&self, sensor: usize, k: Cell, t: usize) -> Option<&Window> {
         let (grid, win) = self.window_of(sensor, t)?;
         let (a0, a1, b0, b1) = grid.span(k);
         (a0 >= win.a0 && b0 >= win.b0 && a1 <= win.a0 + win.na && b1 <= win.b0 + win.nb)
-            .then(|| (win, (a0 - win.a0, a1 - win.a0, b0 - win.b0, b1 - win.b0)))
+            .then_some(win)
     }
 
-    /// Per rectangle of the window, whether an excluded region covers it.
-    fn mask(&self, grid: &ElementaryGrid, win: &Window, excluded: &[Region]) -> Vec<bool> {
-        let mut mask = vec![false; win.na * win.nb];
-        for x in excluded {
-            // Excluded fields of view are unions of rectangles: mark those
-            // whose centre they contain.
-            for b in 0..win.nb {
-                let yc = 0.5 * (grid.ys[win.b0 + b] + grid.ys[win.b0 + b + 1]);
-                if yc < x.rect.y0 || yc > x.rect.y1 {
-                    continue;
+    /// Prefix sums of the unseen mass over `block` (global indices, inside
+    /// the window), leaving out the rectangles of excluded regions (fields
+    /// of view are unions of rectangles: those whose centre they contain).
+    fn block_sums(
+        &self,
+        grid: &ElementaryGrid,
+        win: &Window,
+        block: Block,
+        excluded: &[Region],
+    ) -> BlockSums {
+        let (a0, a1, b0, b1) = block;
+        let w = a1 - a0 + 1;
+        let mut prefix = vec![0.0; w * (b1 - b0 + 1)];
+        let xc: Vec<f64> = (a0..a1)
+            .map(|a| 0.5 * (grid.xs[a] + grid.xs[a + 1]))
+            .collect();
+        for (j, b) in (b0..b1).enumerate() {
+            let yc = 0.5 * (grid.ys[b] + grid.ys[b + 1]);
+            let rows: Vec<&Region> = excluded
+                .iter()
+                .filter(|x| yc >= x.rect.y0 && yc <= x.rect.y1)
+                .collect();
+            let mut row = 0.0;
+            for (i, a) in (a0..a1).enumerate() {
+                if !rows
+                    .iter()
+                    .any(|x| xc[i] >= x.rect.x0 && xc[i] <= x.rect.x1)
+                {
+                    row += win.unseen[(b - win.b0) * win.na + (a - win.a0)];
                 }
-                for a in 0..win.na {
-                    let xc = 0.5 * (grid.xs[win.a0 + a] + grid.xs[win.a0 + a + 1]);
-                    if xc >= x.rect.x0 && xc <= x.rect.x1 {
-                        mask[b * win.na + a] = true;
-                    }
-                }
+                prefix[(j + 1) * w + i + 1] = prefix[j * w + i + 1] + row;
             }
         }
-        mask
+        BlockSums { a0, b0, w, prefix }
     }
 }
 
-/// Subtracts `weight·length` of the ray segment `[r0, r1]` from the unseen
-/// mass of each elementary rectangle it crosses.
+/// Subtracts `weight·length` of the ray segment `[r0, r1]` from `acc`, the
+/// unseen mass of the elementary rectangles of `block`, rectangle by
+/// rectangle (a 2-D DDA over the breakpoints). The segment lies inside the
+/// block; rounding at its edge is clamped.
 #[allow(clippy::too_many_arguments)]
 fn walk(
     grid: &ElementaryGrid,
-    win: &mut Window,
+    block: Block,
+    acc: &mut [f64],
     o: Point,
     d: Point,
     inv: Point,
@@ -421,55 +516,67 @@ fn walk(
     weight: f64,
 ) {
     let (xs, ys) = (&grid.xs, &grid.ys);
+    let (a_lo, a_hi, b_lo, b_hi) = (block.0, block.1 - 1, block.2, block.3 - 1);
+    let na = block.1 - block.0;
     let start = Point::new(o.x + d.x * r0, o.y + d.y * r0);
-    let mut a = ElementaryGrid::locate(xs, start.x, d.x);
-    let mut b = ElementaryGrid::locate(ys, start.y, d.y);
+    let mut a = grid.locate_x(start.x, d.x).clamp(a_lo, a_hi);
+    let mut b = grid.locate_y(start.y, d.y).clamp(b_lo, b_hi);
+    let mut idx = (b - b_lo) * na + (a - a_lo);
+    // Distance to the next boundary on each axis (infinite along an axis
+    // the ray runs parallel to).
+    let forward_x = d.x >= 0.0;
+    let forward_y = d.y >= 0.0;
+    let next_x = |a: usize| {
+        if d.x == 0.0 {
+            f64::INFINITY
+        } else {
+            (xs[if forward_x { a + 1 } else { a }] - o.x) * inv.x
+        }
+    };
+    let next_y = |b: usize| {
+        if d.y == 0.0 {
+            f64::INFINITY
+        } else {
+            (ys[if forward_y { b + 1 } else { b }] - o.y) * inv.y
+        }
+    };
+    let (mut tx, mut ty) = (next_x(a), next_y(b));
     let mut r = r0;
     loop {
-        let tx = if d.x > 0.0 {
-            (xs[a + 1] - o.x) * inv.x
-        } else if d.x < 0.0 {
-            (xs[a] - o.x) * inv.x
-        } else {
-            f64::INFINITY
-        };
-        let ty = if d.y > 0.0 {
-            (ys[b + 1] - o.y) * inv.y
-        } else if d.y < 0.0 {
-            (ys[b] - o.y) * inv.y
-        } else {
-            f64::INFINITY
-        };
-        let next = tx.min(ty).min(r1);
-        if next > r && a >= win.a0 && b >= win.b0 && a < win.a0 + win.na && b < win.b0 + win.nb {
-            win.unseen[(b - win.b0) * win.na + (a - win.a0)] -= weight * (next - r);
+        let step_x = tx <= ty;
+        let boundary = if step_x { tx } else { ty };
+        let end = if boundary < r1 { boundary } else { r1 };
+        if end > r {
+            acc[idx] -= weight * (end - r);
+            r = end;
         }
-        r = r.max(next);
-        if r >= r1 {
+        if boundary >= r1 {
             break;
         }
-        if tx <= ty {
-            if d.x > 0.0 {
+        if step_x {
+            if (forward_x && a == a_hi) || (!forward_x && a == a_lo) {
+                break;
+            }
+            if forward_x {
                 a += 1;
-                if a + 1 >= xs.len() {
-                    break;
-                }
+                idx += 1;
             } else {
-                if a == 0 {
-                    break;
-                }
                 a -= 1;
+                idx -= 1;
             }
-        } else if d.y > 0.0 {
-            b += 1;
-            if b + 1 >= ys.len() {
-                break;
-            }
+            tx = next_x(a);
         } else {
-            if b == 0 {
+            if (forward_y && b == b_hi) || (!forward_y && b == b_lo) {
                 break;
             }
-            b -= 1;
+            if forward_y {
+                b += 1;
+                idx += na;
+            } else {
+                b -= 1;
+                idx -= na;
+            }
+            ty = next_y(b);
         }
     }
 }
@@ -483,21 +590,12 @@ impl Estimator for ExactEstimator<'_> {
         let fk = self.scenario.fov_region(k);
         let near: Vec<&Region> = excluded.iter().filter(|x| x.may_overlap(&fk)).collect();
         let known = self.known_in(&fk, t, &near);
-        let (Some(grid), Some((win, (a0, a1, b0, b1)))) = (self.grid, self.block(sensor, k, t))
-        else {
+        let (Some(grid), Some(win)) = (self.grid, self.block(sensor, k, t)) else {
             return known + self.unseen_by_rays(k, &fk, t, &near);
         };
         let near: Vec<Region> = near.into_iter().copied().collect();
-        let mask = (!near.is_empty()).then(|| self.mask(grid, win, &near));
-        let mut unseen = 0.0;
-        for b in b0..b1 {
-            for a in a0..a1 {
-                let i = b * win.na + a;
-                if mask.as_ref().is_none_or(|m| !m[i]) {
-                    unseen += win.unseen[i];
-                }
-            }
-        }
+        let block = grid.span(k);
+        let unseen = self.block_sums(grid, win, block, &near).sum(block);
         known + unseen
     }
 
@@ -512,23 +610,17 @@ impl Estimator for ExactEstimator<'_> {
             });
             return;
         };
-        // Prefix sums of the (masked) unseen mass over the window.
-        let mask = (!excluded.is_empty()).then(|| self.mask(grid, win, excluded));
-        let w = win.na + 1;
-        let mut prefix = vec![0.0; w * (win.nb + 1)];
-        for b in 0..win.nb {
-            let mut row = 0.0;
-            for a in 0..win.na {
-                let i = b * win.na + a;
-                if mask.as_ref().is_none_or(|m| !m[i]) {
-                    row += win.unseen[i];
-                }
-                prefix[(b + 1) * w + a + 1] = prefix[b * w + a + 1] + row;
-            }
-        }
-        let sum = |a0: usize, a1: usize, b0: usize, b1: usize| {
-            prefix[b1 * w + a1] - prefix[b0 * w + a1] - prefix[b1 * w + a0] + prefix[b0 * w + a0]
-        };
+        // Prefix sums of the (masked) unseen mass over the sensor's reach.
+        let ti = t as i32;
+        let (lo, _, blo, _) = grid.span(Cell {
+            col: (start.col - ti).max(0),
+            row: (start.row - ti).max(0),
+        });
+        let (_, hi, _, bhi) = grid.span(Cell {
+            col: (start.col + ti).min(s.cols - 1),
+            row: (start.row + ti).min(s.rows - 1),
+        });
+        let sums = self.block_sums(grid, win, (lo, hi, blo, bhi), excluded);
         // Known targets at step t that no excluded region holds.
         let moved: Vec<Point> = self
             .known
@@ -537,8 +629,7 @@ impl Estimator for ExactEstimator<'_> {
             .filter(|&p| s.in_zone(p) && !excluded.iter().any(|x| x.contains(p)))
             .collect();
         for_reach(s, start, t, |dc, dr, k| {
-            let (a0, a1, b0, b1) = grid.span(k);
-            let unseen = sum(a0 - win.a0, a1 - win.a0, b0 - win.b0, b1 - win.b0);
+            let unseen = sums.sum(grid.span(k));
             let fk = s.fov_region(k);
             let known = moved.iter().filter(|&&p| fk.contains(p)).count() as f64;
             out.set(t, dc, dr, known + unseen);
