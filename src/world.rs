@@ -139,6 +139,11 @@ impl World {
         }
     }
 
+    /// Targets emitted so far (by every source, in the zone or not).
+    pub fn emitted(&self) -> u64 {
+        self.next_id
+    }
+
     /// Targets inside the closed zone now.
     pub fn in_zone<'a>(&'a self, s: &'a Scenario) -> impl Iterator<Item = &'a SimTarget> + 'a {
         self.targets.iter().filter(move |t| s.in_zone(t.pos))

@@ -1,0 +1,125 @@
+//! The planner's HTTP client, and an in-process server for one-command runs.
+
+use std::time::{Duration, Instant};
+
+use serde::de::DeserializeOwned;
+use vigil::planner::{PlanRequest, PlanResponse};
+use vigil::scenario::ScenarioSpec;
+
+/// A failed call to the planner.
+#[derive(Debug, thiserror::Error)]
+pub enum ClientError {
+    /// The request did not complete.
+    #[error("request to {url} failed: {source}")]
+    Transport {
+        /// The URL called.
+        url: String,
+        /// What went wrong.
+        source: reqwest::Error,
+    },
+    /// The server answered with an error status.
+    #[error("{url} answered {status}: {body}")]
+    Status {
+        /// The URL called.
+        url: String,
+        /// The HTTP status.
+        status: u16,
+        /// The problem+json body.
+        body: String,
+    },
+}
+
+/// A client of one Vigil server.
+#[derive(Debug, Clone)]
+pub struct Client {
+    base: String,
+    http: reqwest::Client,
+}
+
+/// A scenario as the server describes it.
+#[derive(Debug, Clone, serde::Deserialize)]
+pub struct ScenarioInfo {
+    /// Its id on the server.
+    pub id: String,
+    /// Its canonical spec.
+    pub spec: ScenarioSpec,
+}
+
+impl Client {
+    /// A client of the server at `base` (e.g. `http://127.0.0.1:8080`).
+    pub fn new(base: &str) -> Self {
+        Client {
+            base: base.trim_end_matches('/').to_owned(),
+            http: reqwest::Client::builder()
+                .timeout(Duration::from_secs(60))
+                .build()
+                .unwrap_or_default(),
+        }
+    }
+
+    async fn send<T: DeserializeOwned>(
+        &self,
+        url: String,
+        req: reqwest::RequestBuilder,
+    ) -> Result<T, ClientError> {
+        let resp = req.send().await.map_err(|source| ClientError::Transport {
+            url: url.clone(),
+            source,
+        })?;
+        let status = resp.status();
+        if !status.is_success() {
+            let body = resp.text().await.unwrap_or_default();
+            return Err(ClientError::Status {
+                url,
+                status: status.as_u16(),
+                body,
+            });
+        }
+        resp.json()
+            .await
+            .map_err(|source| ClientError::Transport { url, source })
+    }
+
+    /// `GET /v1/scenarios/{id}`.
+    pub async fn scenario(&self, id: &str) -> Result<ScenarioInfo, ClientError> {
+        let url = format!("{}/v1/scenarios/{id}", self.base);
+        self.send(url.clone(), self.http.get(&url)).await
+    }
+
+    /// `POST /v1/scenarios`: registers a spec (or finds it registered).
+    pub async fn register(&self, spec: &ScenarioSpec) -> Result<ScenarioInfo, ClientError> {
+        let url = format!("{}/v1/scenarios", self.base);
+        self.send(url.clone(), self.http.post(&url).json(spec))
+            .await
+    }
+
+    /// `POST /v1/scenarios/{id}/plan`, with its round-trip time in ms.
+    pub async fn plan(
+        &self,
+        id: &str,
+        req: &PlanRequest,
+    ) -> Result<(PlanResponse, f64), ClientError> {
+        let url = format!("{}/v1/scenarios/{id}/plan", self.base);
+        let started = Instant::now();
+        let resp = self
+            .send(url.clone(), self.http.post(&url).json(req))
+            .await?;
+        Ok((resp, started.elapsed().as_secs_f64() * 1e3))
+    }
+}
+
+/// Starts a Vigil server on a free loopback port of this process and
+/// returns its base URL. It serves until the runtime shuts down.
+pub async fn spawn_local_server() -> std::io::Result<String> {
+    let state = tokio::task::spawn_blocking(vigil::http::AppState::new)
+        .await
+        .map_err(std::io::Error::other)?;
+    let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await?;
+    let addr = listener.local_addr()?;
+    tokio::spawn(async move {
+        if let Err(e) = axum::serve(listener, vigil::http::router(state)).await {
+            eprintln!("in-process server stopped: {e}");
+        }
+    });
+    Ok(format!("http://{addr}"))
+}

@@ -1,0 +1,207 @@
+//! Runs: one seed of one policy, many seeds in parallel, and the paper's
+//! experiment grids.
+
+use std::io::IsTerminal;
+use std::sync::Arc;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::Serialize;
+use tokio::sync::Semaphore;
+use vigil::scenario::Scenario;
+
+use crate::client::{Client, ClientError};
+use crate::driver::{Sim, Start};
+use crate::metrics::{Metrics, RunAccumulator, summarize};
+use crate::policy::{ALL_POLICIES, Policy};
+
+/// Everything that defines one run but its seed.
+#[derive(Debug, Clone)]
+pub struct RunConfig {
+    /// Row label (e.g. `1a`).
+    pub label: String,
+    /// How the sensors move.
+    pub policy: Policy,
+    /// The scenario's id on the server.
+    pub scenario_id: String,
+    /// The scenario, validated locally.
+    pub scenario: Scenario,
+    /// Number of sensors.
+    pub sensors: usize,
+    /// Measured steps.
+    pub steps: usize,
+    /// Steps before measuring (sensors observe but hold still).
+    pub warmup: usize,
+    /// Plan horizon; the scenario's by default.
+    pub horizon: Option<usize>,
+    /// Steps of history reported to the planner.
+    pub history: usize,
+    /// Sensors' starting positions.
+    pub start: Start,
+}
+
+/// A failed run.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The planner could not be reached or refused a request.
+    #[error(transparent)]
+    Client(#[from] ClientError),
+    /// The planner broke its contract.
+    #[error("{0}")]
+    Contract(String),
+}
+
+/// Runs one seed. Returns the run's averages and, when `keep` is set, the
+/// finished simulation (for pictures).
+pub async fn run_one(
+    client: &Client,
+    cfg: &RunConfig,
+    seed: u64,
+    keep: bool,
+) -> Result<(Metrics, Option<Sim>), RunError> {
+    let mut sim = Sim::new(
+        cfg.scenario.clone(),
+        cfg.sensors,
+        cfg.start,
+        seed,
+        cfg.history,
+    );
+    // Warm-up: the zone fills to its stationary state while the sensors
+    // watch from their starting cells, building tracks and history.
+    for _ in 0..cfg.warmup {
+        sim.observe();
+        let stay = sim.sensors.clone();
+        sim.advance(stay);
+    }
+    sim.start_window();
+    let mut acc = RunAccumulator::default();
+    for _ in 0..cfg.steps {
+        sim.observe();
+        let (next, predicted) = if cfg.policy.planner().is_some() {
+            let req = sim.plan_request(cfg.policy, cfg.horizon);
+            let (resp, ms) = client.plan(&cfg.scenario_id, &req).await?;
+            acc.add_plan_time(ms);
+            let next = sim.moves_from_plan(&resp).map_err(RunError::Contract)?;
+            (next, resp.expected_by_step.first().copied())
+        } else {
+            (sim.local_moves(cfg.policy), None)
+        };
+        let count = sim.advance(next);
+        acc.add(count);
+        if let Some(p) = predicted {
+            acc.add_calibration(p, count.detected);
+        }
+    }
+    let metrics = acc.finish(sim.detected_once());
+    Ok((metrics, keep.then_some(sim)))
+}
+
+/// One row of a report: a configuration averaged over seeds.
+#[derive(Debug, Clone, Serialize)]
+pub struct Row {
+    /// Row label.
+    pub label: String,
+    /// Policy name.
+    pub policy: String,
+    /// Scenario id.
+    pub scenario: String,
+    /// Number of sensors.
+    pub sensors: usize,
+    /// Target speed.
+    pub target_speed: f64,
+    /// Measured steps per run.
+    pub steps: usize,
+    /// Seeds averaged.
+    pub seeds: usize,
+    /// Means over seeds.
+    pub metrics: Metrics,
+    /// Half-widths of the 95% confidence intervals.
+    pub ci95: Metrics,
+}
+
+/// Runs every configuration for seeds `seed..seed+seeds` (the same seeds,
+/// hence the same target streams, for every configuration), at most `jobs`
+/// runs at a time.
+pub async fn run_all(
+    client: &Client,
+    configs: &[RunConfig],
+    seed: u64,
+    seeds: usize,
+    jobs: usize,
+) -> Result<Vec<Row>, RunError> {
+    let total = (configs.len() * seeds) as u64;
+    let bar = if std::io::stderr().is_terminal() {
+        let bar = ProgressBar::new(total);
+        if let Ok(style) =
+            ProgressStyle::with_template("{bar:40} {pos}/{len} runs  {elapsed} (eta {eta}) {msg}")
+        {
+            bar.set_style(style);
+        }
+        bar
+    } else {
+        ProgressBar::hidden()
+    };
+    let permits = Arc::new(Semaphore::new(jobs.max(1)));
+    let mut tasks = tokio::task::JoinSet::new();
+    for (ci, cfg) in configs.iter().enumerate() {
+        for k in 0..seeds {
+            let (client, cfg, permits, bar) =
+                (client.clone(), cfg.clone(), permits.clone(), bar.clone());
+            tasks.spawn(async move {
+                let _permit = permits.acquire_owned().await;
+                let out = run_one(&client, &cfg, seed + k as u64, false).await;
+                bar.inc(1);
+                bar.set_message(cfg.label.clone());
+                (ci, k, out)
+            });
+        }
+    }
+    let mut results: Vec<Vec<Option<Metrics>>> = vec![vec![None; seeds]; configs.len()];
+    while let Some(joined) = tasks.join_next().await {
+        let (ci, k, out) =
+            joined.map_err(|e| RunError::Contract(format!("a run panicked: {e}")))?;
+        results[ci][k] = Some(out?.0);
+    }
+    bar.finish_and_clear();
+    Ok(configs
+        .iter()
+        .zip(results)
+        .map(|(cfg, runs)| {
+            let runs: Vec<Metrics> = runs.into_iter().flatten().collect();
+            let (metrics, ci95) = summarize(&runs);
+            Row {
+                label: cfg.label.clone(),
+                policy: cfg.policy.name().to_owned(),
+                scenario: cfg.scenario_id.clone(),
+                sensors: cfg.sensors,
+                target_speed: cfg.scenario.speed,
+                steps: cfg.steps,
+                seeds: runs.len(),
+                metrics,
+                ci95,
+            }
+        })
+        .collect())
+}
+
+/// The paper's experiment grid: (number of sensors, scenario id), numbered
+/// 1–4 as our table rows.
+pub const GRID: [(usize, &str); 4] = [
+    (10, "paper-v10"),
+    (6, "paper-v10"),
+    (10, "paper-v15"),
+    (6, "paper-v15"),
+];
+
+/// The policies of an experiment, with their row letters: Table 1 compares
+/// the paper's method with (a) and without (b) coordination; Table 2 runs
+/// every policy.
+pub fn experiment_policies(name: &str) -> Option<Vec<(char, Policy)>> {
+    match name {
+        "table1" => Some(vec![
+            ('a', Policy::Paper),
+            ('b', Policy::PaperUncoordinated),
+        ]),
+        "table2" => Some(('a'..).zip(ALL_POLICIES).collect()),
+        _ => None,
+    }
+}

@@ -1,0 +1,18 @@
+//! `vigil-sim`: simulates the paper's world and drives a Vigil planner over
+//! HTTP one step at a time, as an external simulator would.
+//!
+//! - [`driver`]: the world, the sensors and the step loop;
+//! - [`policy`]: the sensor policies, local baselines and planner clients;
+//! - [`metrics`]: per-step counts, per-run averages, confidence intervals;
+//! - [`client`]: the HTTP client, and an in-process server for one-command runs;
+//! - [`experiment`]: runs over seeds and the paper's experiment grids;
+//! - [`report`]: the paper's table layout and JSON output;
+//! - [`svg`]: a picture of one run, like the paper's Figure 3.
+
+pub mod client;
+pub mod driver;
+pub mod experiment;
+pub mod metrics;
+pub mod policy;
+pub mod report;
+pub mod svg;

@@ -1,0 +1,179 @@
+//! `vigil-sim`: simulates the world and drives a Vigil planner over HTTP one
+//! step at a time; reproduces the paper's tables against baselines.
+//!
+//! ```text
+//! vigil-sim --experiment table1 --seeds 10          # the paper's Table 1
+//! vigil-sim --experiment table2                     # every policy
+//! vigil-sim --policy exact --sensors 10 --svg run.svg
+//! ```
+//! Without `--server` it starts a server in-process on a loopback port and
+//! still talks HTTP to it.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::Parser;
+use vigil::scenario::{Scenario, ScenarioSpec};
+use vigil_sim::client::{Client, spawn_local_server};
+use vigil_sim::driver::{Start, default_warmup};
+use vigil_sim::experiment::{GRID, RunConfig, experiment_policies, run_all, run_one};
+use vigil_sim::policy::Policy;
+use vigil_sim::{report, svg};
+
+/// Command-line options.
+#[derive(Debug, Parser)]
+#[command(
+    version,
+    about = "Drives the Vigil planner step by step over HTTP and reproduces the paper's tables"
+)]
+struct Args {
+    /// Run an experiment grid (NS ∈ {10, 6} × TV ∈ {10, 15}): `table1`
+    /// (paper vs paper-uncoordinated) or `table2` (every policy).
+    #[arg(long)]
+    experiment: Option<String>,
+    /// Policy of a single run.
+    #[arg(long, value_enum, default_value_t = Policy::Exact)]
+    policy: Policy,
+    /// Number of sensors of a single run.
+    #[arg(long, default_value_t = 10)]
+    sensors: usize,
+    /// Scenario of a single run: a server id, or a ScenarioSpec JSON file.
+    #[arg(long, default_value = "paper-v10")]
+    scenario: String,
+    /// Measured steps per run.
+    #[arg(long, default_value_t = 150)]
+    steps: usize,
+    /// Steps before measuring; default: the steps a target needs to cross
+    /// the zone's diagonal.
+    #[arg(long)]
+    warmup: Option<usize>,
+    /// Seeds per configuration (runs `seed`, `seed+1`, …).
+    #[arg(long, default_value_t = 5)]
+    seeds: usize,
+    /// First seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Plan horizon T; the scenario's by default.
+    #[arg(long)]
+    horizon: Option<usize>,
+    /// Steps of history (sensor positions and tracks) reported to the planner.
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u8).range(0..=32))]
+    history: u8,
+    /// Where the sensors start.
+    #[arg(long, value_enum, default_value_t = Start::Grid)]
+    start: Start,
+    /// A running vigil-server (e.g. http://127.0.0.1:8080); by default one
+    /// is started in-process.
+    #[arg(long)]
+    server: Option<String>,
+    /// Write the results as JSON.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Draw a single run (its first seed) as SVG.
+    #[arg(long)]
+    svg: Option<PathBuf>,
+    /// Runs in flight at once.
+    #[arg(long, default_value_t = 4)]
+    jobs: usize,
+}
+
+#[tokio::main]
+async fn main() -> ExitCode {
+    let args = Args::parse();
+    match run(args).await {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("vigil-sim: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+async fn resolve(client: &Client, scenario: &str) -> Result<(String, Scenario), String> {
+    let info = if scenario.ends_with(".json") || std::path::Path::new(scenario).is_file() {
+        let text = std::fs::read_to_string(scenario).map_err(|e| format!("{scenario}: {e}"))?;
+        let spec: ScenarioSpec =
+            serde_json::from_str(&text).map_err(|e| format!("{scenario}: {e}"))?;
+        client.register(&spec).await.map_err(|e| e.to_string())?
+    } else {
+        client.scenario(scenario).await.map_err(|e| e.to_string())?
+    };
+    let local = Scenario::new(info.spec).map_err(|e| format!("{}: {e}", info.id))?;
+    Ok((info.id, local))
+}
+
+async fn run(args: Args) -> Result<(), String> {
+    let base = match &args.server {
+        Some(url) => url.clone(),
+        None => spawn_local_server()
+            .await
+            .map_err(|e| format!("cannot start a server: {e}"))?,
+    };
+    let client = Client::new(&base);
+    let config =
+        |label: String, policy: Policy, id: String, scenario: Scenario, sensors: usize| RunConfig {
+            label,
+            policy,
+            warmup: args.warmup.unwrap_or_else(|| default_warmup(&scenario)),
+            scenario_id: id,
+            scenario,
+            sensors,
+            steps: args.steps,
+            horizon: args.horizon,
+            history: args.history.into(),
+            start: args.start,
+        };
+    let configs = match &args.experiment {
+        Some(name) => {
+            let policies = experiment_policies(name)
+                .ok_or_else(|| format!("unknown experiment `{name}` (table1, table2)"))?;
+            let mut configs = Vec::new();
+            for (n, (sensors, id)) in GRID.iter().enumerate() {
+                let (id, scenario) = resolve(&client, id).await?;
+                for &(letter, policy) in &policies {
+                    configs.push(config(
+                        format!("{}{letter}", n + 1),
+                        policy,
+                        id.clone(),
+                        scenario.clone(),
+                        *sensors,
+                    ));
+                }
+            }
+            configs
+        }
+        None => {
+            let (id, scenario) = resolve(&client, &args.scenario).await?;
+            vec![config(
+                args.policy.name().to_owned(),
+                args.policy,
+                id,
+                scenario,
+                args.sensors,
+            )]
+        }
+    };
+    if configs.iter().any(|c| c.sensors == 0) {
+        return Err("--sensors must be at least 1".into());
+    }
+    let rows = run_all(&client, &configs, args.seed, args.seeds.max(1), args.jobs)
+        .await
+        .map_err(|e| e.to_string())?;
+    print!("{}", report::table(&rows));
+    if let Some(path) = &args.json {
+        let text = report::json(&rows).map_err(|e| e.to_string())?;
+        std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    if let Some(path) = &args.svg {
+        if args.experiment.is_some() {
+            return Err("--svg draws a single run; drop --experiment".into());
+        }
+        let (_, sim) = run_one(&client, &configs[0], args.seed, true)
+            .await
+            .map_err(|e| e.to_string())?;
+        if let Some(sim) = sim {
+            svg::draw(&sim, path)?;
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,209 @@
+//! Metrics: counts per step, averages per run, means and 95% confidence
+//! intervals over seeds.
+
+use serde::Serialize;
+
+/// What one step's counting found.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StepCount {
+    /// Targets in the zone.
+    pub in_zone: usize,
+    /// Detected by at least one sensor.
+    pub detected: usize,
+    /// Detected by exactly one, two, three sensors.
+    pub by_exactly: [usize; 3],
+}
+
+/// Accumulates the steps of one run.
+#[derive(Debug, Clone, Default)]
+pub struct RunAccumulator {
+    steps: usize,
+    ad: f64,
+    zd: f64,
+    af_sum: f64,
+    af_steps: usize,
+    d: [f64; 3],
+    realized_next: f64,
+    predicted_next: f64,
+    plan_ms: Vec<f64>,
+}
+
+impl RunAccumulator {
+    /// Adds one measured step.
+    pub fn add(&mut self, c: StepCount) {
+        self.steps += 1;
+        self.ad += c.detected as f64;
+        self.zd += (c.in_zone - c.detected) as f64;
+        if c.in_zone > 0 {
+            self.af_sum += c.detected as f64 / c.in_zone as f64;
+            self.af_steps += 1;
+        }
+        for (d, n) in self.d.iter_mut().zip(c.by_exactly) {
+            *d += n as f64;
+        }
+    }
+
+    /// Adds a planner's prediction for the next step and what happened.
+    pub fn add_calibration(&mut self, predicted: f64, realized: usize) {
+        self.predicted_next += predicted;
+        self.realized_next += realized as f64;
+    }
+
+    /// Adds a plan round trip.
+    pub fn add_plan_time(&mut self, ms: f64) {
+        self.plan_ms.push(ms);
+    }
+
+    /// The run's averages. `detected_once` is computed by the driver.
+    pub fn finish(mut self, detected_once: f64) -> Metrics {
+        let n = self.steps.max(1) as f64;
+        let planner = !self.plan_ms.is_empty();
+        self.plan_ms.sort_by(f64::total_cmp);
+        let pct = |p: f64| {
+            let v = &self.plan_ms;
+            v[((p * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1]
+        };
+        Metrics {
+            ad: self.ad / n,
+            zd: self.zd / n,
+            af: if self.af_steps > 0 {
+                self.af_sum / self.af_steps as f64
+            } else {
+                0.0
+            },
+            d1s: self.d[0] / n,
+            d2s: self.d[1] / n,
+            d3s: self.d[2] / n,
+            detected_once,
+            calibration: (planner && self.predicted_next > 0.0)
+                .then(|| self.realized_next / self.predicted_next),
+            plan_ms_p50: planner.then(|| pct(0.5)),
+            plan_ms_p99: planner.then(|| pct(0.99)),
+        }
+    }
+}
+
+/// Per-step averages of one run (or their means over seeds).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct Metrics {
+    /// Targets in the zone detected by at least one sensor.
+    pub ad: f64,
+    /// Targets in the zone detected by none.
+    pub zd: f64,
+    /// Mean over steps with targets of the fraction detected.
+    pub af: f64,
+    /// Detected by exactly one sensor.
+    pub d1s: f64,
+    /// Detected by exactly two sensors.
+    pub d2s: f64,
+    /// Detected by exactly three sensors.
+    pub d3s: f64,
+    /// Fraction of the targets that entered during the measured window that
+    /// were detected at least once.
+    pub detected_once: f64,
+    /// Σ realized AD at the next step / Σ the plan's `expected_by_step[0]`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub calibration: Option<f64>,
+    /// Median plan round trip, ms.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plan_ms_p50: Option<f64>,
+    /// 99th percentile plan round trip, ms.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plan_ms_p99: Option<f64>,
+}
+
+/// Two-sided 97.5% quantile of Student's t with `df` degrees of freedom.
+pub fn t_975(df: usize) -> f64 {
+    const TABLE: [f64; 30] = [
+        12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160,
+        2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056,
+        2.052, 2.048, 2.045, 2.042,
+    ];
+    match df {
+        0 => f64::INFINITY,
+        1..=30 => TABLE[df - 1],
+        _ => 1.96 + 2.4 / df as f64,
+    }
+}
+
+/// Mean and half-width of the 95% confidence interval (0 for one sample).
+pub fn mean_ci(xs: &[f64]) -> (f64, f64) {
+    let n = xs.len();
+    if n == 0 {
+        return (f64::NAN, f64::NAN);
+    }
+    let m = xs.iter().sum::<f64>() / n as f64;
+    if n == 1 {
+        return (m, 0.0);
+    }
+    let var = xs.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1) as f64;
+    (m, t_975(n - 1) * (var / n as f64).sqrt())
+}
+
+/// Means and CI half-widths over seeds, field by field.
+pub fn summarize(runs: &[Metrics]) -> (Metrics, Metrics) {
+    fn field(runs: &[Metrics], f: impl Fn(&Metrics) -> f64) -> (f64, f64) {
+        mean_ci(&runs.iter().map(f).collect::<Vec<_>>())
+    }
+    fn opt(runs: &[Metrics], f: impl Fn(&Metrics) -> Option<f64>) -> (Option<f64>, Option<f64>) {
+        let v: Vec<f64> = runs.iter().filter_map(f).collect();
+        if v.is_empty() {
+            return (None, None);
+        }
+        let (m, c) = mean_ci(&v);
+        (Some(m), Some(c))
+    }
+    let mut mean = Metrics::default();
+    let mut ci = Metrics::default();
+    (mean.ad, ci.ad) = field(runs, |m| m.ad);
+    (mean.zd, ci.zd) = field(runs, |m| m.zd);
+    (mean.af, ci.af) = field(runs, |m| m.af);
+    (mean.d1s, ci.d1s) = field(runs, |m| m.d1s);
+    (mean.d2s, ci.d2s) = field(runs, |m| m.d2s);
+    (mean.d3s, ci.d3s) = field(runs, |m| m.d3s);
+    (mean.detected_once, ci.detected_once) = field(runs, |m| m.detected_once);
+    (mean.calibration, ci.calibration) = opt(runs, |m| m.calibration);
+    (mean.plan_ms_p50, ci.plan_ms_p50) = opt(runs, |m| m.plan_ms_p50);
+    (mean.plan_ms_p99, ci.plan_ms_p99) = opt(runs, |m| m.plan_ms_p99);
+    (mean, ci)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn accumulates_per_step_averages() {
+        let mut acc = RunAccumulator::default();
+        acc.add(StepCount {
+            in_zone: 10,
+            detected: 4,
+            by_exactly: [3, 1, 0],
+        });
+        acc.add(StepCount {
+            in_zone: 0,
+            detected: 0,
+            by_exactly: [0, 0, 0],
+        });
+        acc.add(StepCount {
+            in_zone: 5,
+            detected: 5,
+            by_exactly: [2, 2, 1],
+        });
+        let m = acc.finish(0.5);
+        assert_eq!(m.ad, 3.0);
+        assert_eq!(m.zd, 2.0);
+        // Mean of 0.4 and 1.0, skipping the empty step.
+        assert!((m.af - 0.7).abs() < 1e-12);
+        assert_eq!((m.d1s, m.d2s, m.d3s), (5.0 / 3.0, 1.0, 1.0 / 3.0));
+        assert_eq!(m.calibration, None);
+    }
+
+    #[test]
+    fn confidence_interval_uses_student_t() {
+        let (m, c) = mean_ci(&[1.0, 2.0, 3.0, 4.0]);
+        assert_eq!(m, 2.5);
+        // sd = 1.291, se = 0.6455, t(3) = 3.182.
+        assert!((c - 3.182 * (5.0f64 / 3.0).sqrt() / 2.0).abs() < 1e-9);
+    }
+}

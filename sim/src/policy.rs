@@ -1,0 +1,199 @@
+//! Sensor policies: local baselines and the planner in its configurations.
+
+use std::fmt;
+
+use rand::RngExt;
+use serde::{Deserialize, Serialize};
+use vigil::coordination::Coordination;
+use vigil::geometry::Point;
+use vigil::planner::{EstimatorKind, Observed};
+use vigil::scenario::{Cell, FovSpec, Scenario};
+use vigil::search::MOVES;
+
+/// How the sensors move.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum Policy {
+    /// Never move.
+    Stationary,
+    /// A uniform legal move each step.
+    Random,
+    /// A-CMOMMT-style local force control (attraction to observed targets,
+    /// repulsion from nearby sensors).
+    LocalForce,
+    /// Paper estimator, no coordination (Table 1's 'b' rows).
+    PaperUncoordinated,
+    /// Paper estimator, priority coordination (Table 1's 'a' rows).
+    Paper,
+    /// Exact estimator, priority coordination.
+    Exact,
+    /// Exact estimator, iterated coordination.
+    ExactIterated,
+    /// Exact, iterated, with every target in the zone reported: a reference
+    /// ceiling, not something a real system can run.
+    Clairvoyant,
+}
+
+/// Every policy, in report order.
+pub const ALL_POLICIES: [Policy; 8] = [
+    Policy::Paper,
+    Policy::PaperUncoordinated,
+    Policy::Exact,
+    Policy::ExactIterated,
+    Policy::Clairvoyant,
+    Policy::LocalForce,
+    Policy::Random,
+    Policy::Stationary,
+];
+
+/// How a planner policy calls the planner.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PlannerSettings {
+    /// Estimator.
+    pub estimator: EstimatorKind,
+    /// Coordination.
+    pub coordination: Coordination,
+    /// What the reported targets cover.
+    pub observed: Observed,
+}
+
+impl Policy {
+    /// The planner configuration, or `None` for a local policy.
+    pub fn planner(self) -> Option<PlannerSettings> {
+        use Coordination as C;
+        use EstimatorKind as E;
+        let (estimator, coordination, observed) = match self {
+            Policy::Stationary | Policy::Random | Policy::LocalForce => return None,
+            Policy::PaperUncoordinated => (E::Paper, C::None, Observed::Sensors),
+            Policy::Paper => (E::Paper, C::Priority, Observed::Sensors),
+            Policy::Exact => (E::Exact, C::Priority, Observed::Sensors),
+            Policy::ExactIterated => (E::Exact, C::Iterated, Observed::Sensors),
+            Policy::Clairvoyant => (E::Exact, C::Iterated, Observed::Zone),
+        };
+        Some(PlannerSettings {
+            estimator,
+            coordination,
+            observed,
+        })
+    }
+
+    /// The policy's name on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Policy::Stationary => "stationary",
+            Policy::Random => "random",
+            Policy::LocalForce => "local-force",
+            Policy::PaperUncoordinated => "paper-uncoordinated",
+            Policy::Paper => "paper",
+            Policy::Exact => "exact",
+            Policy::ExactIterated => "exact-iterated",
+            Policy::Clairvoyant => "clairvoyant",
+        }
+    }
+}
+
+impl fmt::Display for Policy {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The legal moves from `c`: the nine of [`MOVES`] that stay on the lattice.
+pub fn legal_moves(s: &Scenario, c: Cell) -> Vec<Cell> {
+    MOVES
+        .iter()
+        .map(|&(dc, dr)| Cell {
+            col: c.col + dc,
+            row: c.row + dr,
+        })
+        .filter(|&n| s.on_lattice(n))
+        .collect()
+}
+
+/// A uniform legal move.
+pub fn random_move(s: &Scenario, c: Cell, rng: &mut impl rand::Rng) -> Cell {
+    let moves = legal_moves(s, c);
+    moves[rng.random_range(0..moves.len())]
+}
+
+/// Constants of the local force law.
+pub mod force {
+    /// Weight of the attraction to each observed target.
+    pub const ATTRACTION: f64 = 1.0;
+    /// Weight of the repulsion from each nearby sensor, at zero distance.
+    pub const REPULSION: f64 = 2.0;
+    /// Sensors repel within this many field-of-view half widths (two half
+    /// widths: the fields of view touch).
+    pub const REPULSION_RANGE: f64 = 2.0;
+    /// Below this net force the sensor stays.
+    pub const DEADBAND: f64 = 0.25;
+}
+
+/// Local force control after Parker's A-CMOMMT (2002), on the lattice:
+/// - attraction: a unit vector towards each target inside the sensor's own
+///   field of view, times [`force::ATTRACTION`] (so a sensor keeps its
+///   targets in view and drifts toward where they cluster);
+/// - repulsion: for each other sensor closer than `REPULSION_RANGE`
+///   half widths, a unit vector away from it times
+///   `REPULSION·(1 − d/range)` (so fields of view spread out).
+///
+/// The sensor takes the legal move whose direction best aligns with the net
+/// force (the move maximising `force·move/|move|`), or stays when the force
+/// is below [`force::DEADBAND`] or no move points along it.
+pub fn local_force_move(s: &Scenario, me: usize, sensors: &[Cell], observed: &[Point]) -> Cell {
+    let here = sensors[me];
+    let p = s.centre(here);
+    let half = match s.fov {
+        FovSpec::Square { half_width } => half_width,
+        FovSpec::Circle { radius } => radius,
+    };
+    let region = s.fov_region(here);
+    let (mut fx, mut fy) = (0.0, 0.0);
+    for t in observed.iter().filter(|&&t| region.contains(t)) {
+        let (dx, dy) = (t.x - p.x, t.y - p.y);
+        let d = dx.hypot(dy);
+        if d > 1e-9 {
+            fx += force::ATTRACTION * dx / d;
+            fy += force::ATTRACTION * dy / d;
+        }
+    }
+    let range = force::REPULSION_RANGE * half;
+    for (j, &other) in sensors.iter().enumerate() {
+        if j == me {
+            continue;
+        }
+        let q = s.centre(other);
+        let (dx, dy) = (p.x - q.x, p.y - q.y);
+        let d = dx.hypot(dy);
+        if d < range {
+            // Co-located sensors push apart along a fixed, per-pair direction.
+            let (ux, uy) = if d > 1e-9 {
+                (dx / d, dy / d)
+            } else {
+                let a = (me as f64 - j as f64) * 2.399;
+                (a.cos(), a.sin())
+            };
+            let w = force::REPULSION * (1.0 - d / range);
+            fx += w * ux;
+            fy += w * uy;
+        }
+    }
+    if fx.hypot(fy) < force::DEADBAND {
+        return here;
+    }
+    let mut best = here;
+    let mut best_score = 0.0;
+    for n in legal_moves(s, here) {
+        let (dc, dr) = ((n.col - here.col) as f64, (n.row - here.row) as f64);
+        let len = dc.hypot(dr);
+        if len == 0.0 {
+            continue;
+        }
+        let score = (fx * dc + fy * dr) / len;
+        if score > best_score + 1e-12 {
+            best_score = score;
+            best = n;
+        }
+    }
+    best
+}

@@ -1,0 +1,79 @@
+//! Reports: the paper's table layout on stdout, and JSON.
+
+use std::fmt::Write as _;
+
+use serde::Serialize;
+
+use crate::experiment::Row;
+
+fn pm(mean: f64, ci: f64, decimals: usize) -> String {
+    format!("{mean:.decimals$}±{ci:.decimals$}")
+}
+
+fn opt(mean: Option<f64>, ci: Option<f64>, decimals: usize) -> String {
+    match (mean, ci) {
+        (Some(m), Some(c)) => pm(m, c, decimals),
+        _ => "-".to_owned(),
+    }
+}
+
+/// The rows as a table: the paper's columns (EN NS AD ZD AF D1S D2S D3S TV),
+/// then ours (policy, detected once, calibration, plan round trip p50/p99),
+/// each mean ± the half-width of its 95% confidence interval over seeds.
+pub fn table(rows: &[Row]) -> String {
+    let header = [
+        "EN", "NS", "AD", "ZD", "AF", "D1S", "D2S", "D3S", "TV", "policy", "once", "calib",
+        "p50 ms", "p99 ms",
+    ];
+    let body: Vec<[String; 14]> = rows
+        .iter()
+        .map(|r| {
+            let (m, c) = (&r.metrics, &r.ci95);
+            [
+                r.label.clone(),
+                r.sensors.to_string(),
+                pm(m.ad, c.ad, 1),
+                pm(m.zd, c.zd, 1),
+                pm(m.af, c.af, 2),
+                pm(m.d1s, c.d1s, 1),
+                pm(m.d2s, c.d2s, 2),
+                pm(m.d3s, c.d3s, 2),
+                format!("{}", r.target_speed),
+                r.policy.clone(),
+                pm(m.detected_once, c.detected_once, 2),
+                opt(m.calibration, c.calibration, 2),
+                opt(m.plan_ms_p50, c.plan_ms_p50, 2),
+                opt(m.plan_ms_p99, c.plan_ms_p99, 2),
+            ]
+        })
+        .collect();
+    let mut widths: Vec<usize> = header.iter().map(|h| h.chars().count()).collect();
+    for row in &body {
+        for (w, cell) in widths.iter_mut().zip(row) {
+            *w = (*w).max(cell.chars().count());
+        }
+    }
+    let mut out = String::new();
+    let line = |cells: &mut dyn Iterator<Item = &str>, out: &mut String| {
+        let parts: Vec<String> = cells
+            .zip(&widths)
+            .map(|(c, &w)| format!("{c:>w$}"))
+            .collect();
+        let _ = writeln!(out, "{}", parts.join("  ").trim_end());
+    };
+    line(&mut header.iter().copied(), &mut out);
+    for row in &body {
+        line(&mut row.iter().map(String::as_str), &mut out);
+    }
+    out
+}
+
+/// The JSON report: `{"runs":[{label, policy, scenario, sensors,
+/// target_speed, steps, seeds, metrics, ci95}]}`.
+pub fn json(rows: &[Row]) -> serde_json::Result<String> {
+    #[derive(Serialize)]
+    struct Report<'a> {
+        runs: &'a [Row],
+    }
+    serde_json::to_string_pretty(&Report { runs: rows })
+}

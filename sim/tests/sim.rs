@@ -1,0 +1,188 @@
+//! Tests of the simulation client: the world model against the scenario's
+//! statistics, common random numbers, legal moves, and an end-to-end run
+//! over HTTP.
+
+use vigil::scenario::{Cell, builtins};
+use vigil::stats::Stats;
+use vigil_sim::client::{Client, spawn_local_server};
+use vigil_sim::driver::{Sim, Start, default_warmup};
+use vigil_sim::experiment::{RunConfig, run_all, run_one};
+use vigil_sim::policy::{ALL_POLICIES, Policy, local_force_move};
+
+fn assert_legal(sim: &Sim) {
+    for trace in &sim.trace {
+        for w in trace.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            assert!(
+                (a.col - b.col).abs() <= 1 && (a.row - b.row).abs() <= 1,
+                "{a:?} → {b:?}"
+            );
+            assert!(sim.scenario.on_lattice(b), "{b:?} off the lattice");
+        }
+    }
+}
+
+/// Emissions are Poisson with the scenario's total rate, and after the
+/// warm-up the zone holds `expected_targets_in_zone` on average: each
+/// within four standard errors.
+#[test]
+fn world_matches_the_scenario_statistics() {
+    let s = builtins().remove(0);
+    let stats = Stats::compute(&s);
+    let rate: f64 = s.sources.iter().map(|src| src.rate).sum();
+    let (seeds, steps) = (400u64, 60usize);
+    let mut emitted = Vec::new();
+    let mut counts = Vec::new();
+    for seed in 0..seeds {
+        let mut sim = Sim::new(s.clone(), 1, Start::Grid, seed, 0);
+        for _ in 0..steps {
+            let stay = sim.sensors.clone();
+            sim.advance(stay);
+        }
+        emitted.push(sim.world.emitted() as f64);
+        counts.push(sim.world.in_zone(&s).count() as f64);
+    }
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let se = |v: &[f64]| {
+        let m = mean(v);
+        (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64 / v.len() as f64)
+            .sqrt()
+    };
+    let expected_emitted = rate * steps as f64;
+    assert!(
+        (mean(&emitted) - expected_emitted).abs() <= 4.0 * se(&emitted),
+        "emitted {} ± {}, expected {expected_emitted}",
+        mean(&emitted),
+        se(&emitted)
+    );
+    // 60 steps exceed the 43-step warm-up, so the zone is stationary.
+    assert!(steps >= default_warmup(&s));
+    assert!(
+        (mean(&counts) - stats.expected_targets_in_zone).abs() <= 4.0 * se(&counts),
+        "in zone {} ± {}, expected {}",
+        mean(&counts),
+        se(&counts),
+        stats.expected_targets_in_zone
+    );
+}
+
+/// Every policy sees the same targets for the same seed, however its
+/// sensors move (their RNG is separate).
+#[test]
+fn policies_share_the_target_stream() {
+    let s = builtins().remove(1);
+    let run = |policy: Policy, start: Start| {
+        let mut sim = Sim::new(s.clone(), 6, start, 42, 16);
+        for _ in 0..80 {
+            sim.observe();
+            let next = sim.local_moves(policy);
+            sim.advance(next);
+        }
+        sim.world
+            .targets
+            .iter()
+            .map(|t| (t.id, t.pos.x.to_bits(), t.pos.y.to_bits()))
+            .collect::<Vec<_>>()
+    };
+    let reference = run(Policy::Stationary, Start::Grid);
+    assert!(!reference.is_empty());
+    assert_eq!(reference, run(Policy::Random, Start::Random));
+    assert_eq!(reference, run(Policy::LocalForce, Start::Grid));
+    // A different seed gives a different stream.
+    let mut other = Sim::new(s.clone(), 6, Start::Grid, 43, 16);
+    for _ in 0..80 {
+        let stay = other.sensors.clone();
+        other.advance(stay);
+    }
+    let other: Vec<_> = other
+        .world
+        .targets
+        .iter()
+        .map(|t| (t.id, t.pos.x.to_bits(), t.pos.y.to_bits()))
+        .collect();
+    assert_ne!(reference, other);
+}
+
+#[test]
+fn local_policies_move_legally() {
+    let s = builtins().remove(0);
+    for policy in [Policy::Stationary, Policy::Random, Policy::LocalForce] {
+        for seed in 0..5 {
+            let mut sim = Sim::new(s.clone(), 12, Start::Random, seed, 0);
+            for _ in 0..120 {
+                sim.observe();
+                let next = sim.local_moves(policy);
+                sim.advance(next);
+            }
+            assert_legal(&sim);
+            if policy == Policy::Stationary {
+                assert!(sim.trace.iter().all(|t| t.iter().all(|&c| c == t[0])));
+            }
+        }
+    }
+}
+
+#[test]
+fn local_force_attracts_and_repels() {
+    let s = builtins().remove(0);
+    let me = Cell { col: 10, row: 10 };
+    let p = s.centre(me);
+    // A target to the north-east inside the field of view pulls that way.
+    let target = vigil::geometry::Point::new(p.x + 20.0, p.y + 20.0);
+    assert_eq!(
+        local_force_move(&s, 0, &[me], &[target]),
+        Cell { col: 11, row: 11 }
+    );
+    // A sensor just west pushes east; nothing to do when alone.
+    assert_eq!(
+        local_force_move(&s, 0, &[me, Cell { col: 9, row: 10 }], &[]),
+        Cell { col: 11, row: 10 }
+    );
+    assert_eq!(local_force_move(&s, 0, &[me], &[]), me);
+}
+
+/// A short run of every policy over HTTP against an in-process server:
+/// moves are legal (the driver checks each plan too), metrics are sane,
+/// and planner policies report calibration and round trips.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn end_to_end_over_http() {
+    let base = spawn_local_server().await.expect("server");
+    let client = Client::new(&base);
+    let info = client.scenario("paper-v10").await.expect("built-in");
+    let scenario = vigil::scenario::Scenario::new(info.spec).expect("valid");
+    let configs: Vec<RunConfig> = ALL_POLICIES
+        .iter()
+        .map(|&policy| RunConfig {
+            label: policy.name().into(),
+            policy,
+            scenario_id: info.id.clone(),
+            scenario: scenario.clone(),
+            sensors: 4,
+            steps: 15,
+            warmup: 20,
+            horizon: Some(2),
+            history: 4,
+            start: Start::Grid,
+        })
+        .collect();
+    let rows = run_all(&client, &configs, 7, 2, 4).await.expect("runs");
+    assert_eq!(rows.len(), ALL_POLICIES.len());
+    for row in &rows {
+        let m = &row.metrics;
+        assert_eq!(row.seeds, 2);
+        assert!(m.ad + m.zd > 0.0, "{}: an empty zone", row.policy);
+        assert!((0.0..=1.0).contains(&m.af) && (0.0..=1.0).contains(&m.detected_once));
+        assert!(m.d1s + m.d2s + m.d3s <= m.ad + 1e-9);
+        let policy = ALL_POLICIES
+            .iter()
+            .find(|p| p.name() == row.policy)
+            .expect("a known policy");
+        let planner = policy.planner().is_some();
+        assert_eq!(m.plan_ms_p50.is_some(), planner, "{}", row.policy);
+        assert_eq!(m.calibration.is_some(), planner, "{}", row.policy);
+    }
+    for cfg in &configs {
+        let (_, sim) = run_one(&client, cfg, 3, true).await.expect("run");
+        assert_legal(&sim.expect("kept"));
+    }
+}
