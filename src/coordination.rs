@@ -20,6 +20,7 @@
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use utoipa::ToSchema;
 
 use crate::estimator::{Estimator, for_reach};
 use crate::geometry::Region;
@@ -27,7 +28,7 @@ use crate::scenario::{Cell, Scenario};
 use crate::search::{BestPath, ValueGrid, best_path};
 
 /// How sensors' searches are coordinated.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum Coordination {
     /// Every sensor plans alone (the paper's 'b' rows).

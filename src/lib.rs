@@ -12,7 +12,8 @@
 //! - [`planner`]: a scenario's planner and the request/response types;
 //! - [`world`]: a simulation of the target process, for checks and simulators.
 //!
-//! [`http`] is the thin HTTP layer over them.
+//! [`http`] is the thin HTTP layer over them, and [`store`] keeps
+//! registered scenarios on disk.
 
 pub mod coordination;
 pub mod estimator;
@@ -22,4 +23,5 @@ pub mod planner;
 pub mod scenario;
 pub mod search;
 pub mod stats;
+pub mod store;
 pub mod world;

@@ -7,6 +7,7 @@ use std::collections::HashSet;
 use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
+use utoipa::ToSchema;
 
 use crate::coordination::{Coordination, coordinate};
 use crate::estimator::{
@@ -26,7 +27,7 @@ pub const MAX_HISTORY_STEPS: usize = 32;
 pub const MAX_HISTORY_POSITIONS: usize = 256;
 
 /// Which estimator of `n̂(k,t)` to use.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum EstimatorKind {
     /// The conditional expectation under the model (ours).
@@ -37,7 +38,7 @@ pub enum EstimatorKind {
 }
 
 /// What the reported targets cover.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum Observed {
     /// The targets inside the sensors' fields of view (now and in the history).
@@ -48,12 +49,14 @@ pub enum Observed {
 }
 
 /// A sensor or target id: a string or a number, echoed back as given.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(untagged)]
+#[schema(examples("a", 7))]
 pub enum Id {
     /// A string id.
     Text(String),
     /// A numeric id.
+    #[schema(value_type = f64)]
     Number(serde_json::Number),
 }
 
@@ -67,7 +70,7 @@ impl Id {
 }
 
 /// A sensor's current position.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SensorIn {
     /// Unique id.
@@ -79,7 +82,7 @@ pub struct SensorIn {
 }
 
 /// A reported target.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TargetIn {
     /// Optional id.
@@ -96,7 +99,7 @@ pub struct TargetIn {
 }
 
 /// A past sensor position.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PositionIn {
     /// East coordinate.
@@ -106,19 +109,23 @@ pub struct PositionIn {
 }
 
 /// Body of `POST /v1/scenarios/{id}/plan`.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PlanRequest {
     /// Sensors now.
+    #[schema(min_items = 1, max_items = 256)]
     pub sensors: Vec<SensorIn>,
     /// Targets reported now.
     #[serde(default)]
+    #[schema(max_items = 20000)]
     pub targets: Vec<TargetIn>,
     /// Sensors' positions 1, 2, … steps ago.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(max_items = 32)]
     pub history: Option<Vec<Vec<PositionIn>>>,
     /// Horizon T; the scenario's by default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(minimum = 1, maximum = 12)]
     pub horizon: Option<usize>,
     /// Estimator; `exact` by default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -135,7 +142,7 @@ pub struct PlanRequest {
 }
 
 /// A lattice cell and its centre.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, ToSchema)]
 pub struct CellOut {
     /// Column.
     pub col: i32,
@@ -148,14 +155,14 @@ pub struct CellOut {
 }
 
 /// The search values of one sensor.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
 pub struct Explain {
     /// `values[t−1][dr+T][dc+T]`; null where unreachable or off the lattice.
     pub values: Vec<Vec<Vec<Option<f64>>>>,
 }
 
 /// One sensor's plan.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
 pub struct PlanOut {
     /// The sensor's id.
     pub sensor: Id,
@@ -173,7 +180,7 @@ pub struct PlanOut {
 }
 
 /// Response of a plan request.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
 pub struct PlanResponse {
     /// Scenario id.
     pub scenario: String,
@@ -339,6 +346,14 @@ impl Planner {
             grid,
             precompute_ms: started.elapsed().as_secs_f64() * 1e3,
         }
+    }
+
+    /// Approximate heap memory held, bytes (for cache bounds).
+    pub fn memory_bytes(&self) -> usize {
+        let stats = 3 * self.scenario.cell_count() * std::mem::size_of::<f64>();
+        let grid = self.grid.as_ref().map_or(0, ElementaryGrid::memory_bytes);
+        let rays: usize = self.rays.iter().map(SourceRays::memory_bytes).sum();
+        std::mem::size_of::<Self>() + stats + grid + rays
     }
 
     /// Validates and plans a request.

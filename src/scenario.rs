@@ -6,6 +6,7 @@
 
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
+use utoipa::ToSchema;
 
 use crate::geometry::{Disk, Point, Rect, Region};
 
@@ -40,33 +41,42 @@ impl ValidationError {
 }
 
 /// The surveillance zone `[0,width] × [0,height]`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(examples(json!({"width": 300.0, "height": 300.0})))]
 pub struct ZoneSpec {
     /// Extent east, zone units.
+    #[schema(exclusive_minimum = 0)]
     pub width: f64,
     /// Extent north, zone units.
+    #[schema(exclusive_minimum = 0)]
     pub height: f64,
 }
 
-/// Field of view of every sensor.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+/// Field of view of every sensor, tagged by `shape`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(tag = "shape", rename_all = "lowercase", deny_unknown_fields)]
+#[schema(examples(
+    json!({"shape": "square", "half_width": 30.0}),
+    json!({"shape": "circle", "radius": 30.0})
+))]
 pub enum FovSpec {
     /// The paper's inscribed square, `|dx|, |dy| ≤ half_width`.
     Square {
         /// Half the side of the square.
+        #[schema(exclusive_minimum = 0)]
         half_width: f64,
     },
     /// A disk of the given radius (the paper's future work).
     Circle {
         /// Radius of the disk.
+        #[schema(exclusive_minimum = 0)]
         radius: f64,
     },
 }
 
 /// Direction a source's takeoff half-plane faces.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum Heading {
     /// +x.
@@ -92,14 +102,16 @@ impl Heading {
 }
 
 /// A point source of targets outside the zone.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(examples(json!({"x": -1.0, "y": 100.0, "rate": 0.3, "heading": "east"})))]
 pub struct SourceSpec {
     /// East coordinate.
     pub x: f64,
     /// North coordinate.
     pub y: f64,
     /// Poisson rate, targets per step.
+    #[schema(minimum = 0)]
     pub rate: f64,
     /// Takeoff half-plane; inferred when the source is beside exactly one edge.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -107,24 +119,30 @@ pub struct SourceSpec {
 }
 
 /// A scenario as clients send it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(examples(json!(paper_spec(10.0))))]
 pub struct ScenarioSpec {
     /// Free-form label.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(max_length = 200)]
     pub name: Option<String>,
     /// The zone.
     pub zone: ZoneSpec,
     /// Side of a lattice cell; must divide width and height.
+    #[schema(exclusive_minimum = 0)]
     pub cell_size: f64,
     /// Sensors' field of view.
     pub fov: FovSpec,
     /// Distance a target flies per step.
+    #[schema(exclusive_minimum = 0)]
     pub target_speed: f64,
     /// Target sources.
+    #[schema(max_items = 64)]
     pub sources: Vec<SourceSpec>,
     /// Default planning horizon T (1..=12, default 3).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(minimum = 1, maximum = 12)]
     pub horizon: Option<usize>,
 }
 

@@ -1,7 +1,7 @@
 //! `vigil-server`: serves the Vigil planning API over HTTP.
 //!
 //! ```text
-//! vigil-server [--bind ADDR]     (env VIGIL_BIND, default 127.0.0.1:8080)
+//! vigil-server --help            every option, each with an environment variable
 //! ```
 //!
 //! Logs go to stderr, filtered by `RUST_LOG` (default `info`). The server
@@ -9,56 +9,57 @@
 //! exits with status 0.
 
 use std::io::IsTerminal;
-use std::net::SocketAddr;
 use std::process::ExitCode;
 use std::time::Instant;
 
 use clap::Parser;
 use tokio::net::TcpListener;
 use tracing_subscriber::EnvFilter;
+use vigil::http::config::{Config, LogFormat};
 use vigil::http::{AppState, router};
-
-/// Command-line configuration.
-#[derive(Debug, Parser)]
-#[command(version, about = "Serves the Vigil planning API over HTTP")]
-struct Args {
-    /// Address to listen on.
-    #[arg(long, env = "VIGIL_BIND", default_value = "127.0.0.1:8080")]
-    bind: SocketAddr,
-}
 
 #[tokio::main]
 async fn main() -> ExitCode {
-    let args = Args::parse();
-    tracing_subscriber::fmt()
-        .with_env_filter(
-            EnvFilter::try_from_default_env().unwrap_or_else(|_| EnvFilter::new("info")),
-        )
-        .with_writer(std::io::stderr)
-        .with_ansi(std::io::stderr().is_terminal())
-        .init();
+    let config = Config::parse();
+    let filter = EnvFilter::try_from_default_env().unwrap_or_else(|_| EnvFilter::new("info"));
+    let logs = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr);
+    match config.log_format {
+        LogFormat::Json => logs.json().init(),
+        LogFormat::Human => logs.with_ansi(std::io::stderr().is_terminal()).init(),
+    }
 
     let started = Instant::now();
-    let state = match tokio::task::spawn_blocking(AppState::new).await {
-        Ok(state) => state,
-        Err(e) => {
-            tracing::error!(error = %e, "failed to precompute the built-in scenarios");
-            return ExitCode::FAILURE;
+    let state = {
+        let owned = config.clone();
+        match tokio::task::spawn_blocking(move || AppState::from_config(&owned)).await {
+            Ok(Ok(state)) => state,
+            Ok(Err(e)) => {
+                tracing::error!(data_dir = %config.data_dir.display(), error = %e, "cannot open the scenario store");
+                return ExitCode::FAILURE;
+            }
+            Err(e) => {
+                tracing::error!(error = %e, "failed to load the scenarios");
+                return ExitCode::FAILURE;
+            }
         }
     };
     tracing::info!(
         elapsed_ms = started.elapsed().as_secs_f64() * 1e3,
-        "precomputed the built-in scenarios"
+        scenarios = state.registry.list().len(),
+        data_dir = %config.data_dir.display(),
+        "scenarios ready"
     );
 
-    let listener = match TcpListener::bind(args.bind).await {
+    let listener = match TcpListener::bind(config.bind).await {
         Ok(listener) => listener,
         Err(e) => {
-            tracing::error!(bind = %args.bind, error = %e, "failed to bind");
+            tracing::error!(bind = %config.bind, error = %e, "failed to bind");
             return ExitCode::FAILURE;
         }
     };
-    let addr = listener.local_addr().unwrap_or(args.bind);
+    let addr = listener.local_addr().unwrap_or(config.bind);
     tracing::info!("listening on {addr}");
 
     if let Err(e) = axum::serve(listener, router(state))

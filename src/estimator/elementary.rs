@@ -186,6 +186,13 @@ impl ElementaryGrid {
         })
     }
 
+    /// Approximate heap memory held, bytes.
+    pub fn memory_bytes(&self) -> usize {
+        8 * (self.xs.len() + self.ys.len() + self.prefix.len())
+            + 16 * (self.col_span.len() + self.row_span.len())
+            + 4 * (self.x_buckets.len() + self.y_buckets.len())
+    }
+
     /// Number of elementary intervals in x and in y.
     pub fn dims(&self) -> (usize, usize) {
         (self.xs.len() - 1, self.ys.len() - 1)

@@ -66,6 +66,11 @@ impl SourceRays {
             .collect()
     }
 
+    /// Approximate heap memory held, bytes.
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of::<(Point, Point)>() * self.dirs.len()
+    }
+
     /// Ray indices whose directions can meet `region`.
     fn range(&self, region: &Region, buf: &mut Vec<Point>) -> Option<(usize, usize)> {
         let (lo, hi) = angular_span(&self.source, region, buf)?;

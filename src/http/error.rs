@@ -6,6 +6,7 @@ use axum::extract::rejection::{JsonRejection, PathRejection};
 use axum::http::{HeaderValue, StatusCode, header};
 use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};
+use utoipa::ToSchema;
 
 use crate::scenario::ValidationError;
 
@@ -49,20 +50,40 @@ pub enum ApiError {
     /// A value of the request is outside its bounds. 422.
     #[error(transparent)]
     Validation(#[from] ValidationError),
+    /// No or a wrong API key. 401.
+    #[error("a valid `Authorization: Bearer <key>` header is required")]
+    Unauthorized,
+    /// Shed under load. 503 with Retry-After.
+    #[error("the server is at capacity; retry shortly")]
+    Overloaded,
+    /// The request ran out of time. 504.
+    #[error("the request took longer than the server's time limit")]
+    Timeout,
+    /// A request-level bound other than a field's. 422.
+    #[error("{0}")]
+    Unprocessable(String),
     /// A bug: a background task failed or a response could not be built. 500.
     #[error("internal error: {0}")]
     Internal(String),
 }
 
 /// The body of an error response (RFC 9457).
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[schema(examples(json!({
+    "type": "https://vigil.dev/problems/scenario-not-found",
+    "title": "Scenario not found",
+    "status": 404,
+    "detail": "no scenario with id `nope`"
+})))]
 pub struct Problem {
     /// URI identifying the kind of problem.
     #[serde(rename = "type")]
+    #[schema(format = "uri")]
     pub kind: String,
     /// Short summary of the kind of problem.
     pub title: String,
     /// HTTP status code.
+    #[schema(minimum = 400, maximum = 599)]
     pub status: u16,
     /// What went wrong with this request.
     pub detail: String,
@@ -78,6 +99,10 @@ impl ApiError {
             ApiError::MethodNotAllowed { .. } => StatusCode::METHOD_NOT_ALLOWED,
             ApiError::BuiltinScenario(_) => StatusCode::CONFLICT,
             ApiError::Validation(_) => StatusCode::UNPROCESSABLE_ENTITY,
+            ApiError::Unauthorized => StatusCode::UNAUTHORIZED,
+            ApiError::Overloaded => StatusCode::SERVICE_UNAVAILABLE,
+            ApiError::Timeout => StatusCode::GATEWAY_TIMEOUT,
+            ApiError::Unprocessable(_) => StatusCode::UNPROCESSABLE_ENTITY,
             ApiError::Internal(_) => StatusCode::INTERNAL_SERVER_ERROR,
         }
     }
@@ -93,6 +118,10 @@ impl ApiError {
             ApiError::MethodNotAllowed { .. } => ("method-not-allowed", "Method not allowed"),
             ApiError::BuiltinScenario(_) => ("builtin-scenario", "Built-in scenario"),
             ApiError::Validation(_) => ("validation", "Invalid request"),
+            ApiError::Unauthorized => ("unauthorized", "Unauthorized"),
+            ApiError::Overloaded => ("overloaded", "Service overloaded"),
+            ApiError::Timeout => ("timeout", "Request timed out"),
+            ApiError::Unprocessable(_) => ("validation", "Invalid request"),
             ApiError::Internal(_) => ("internal", "Internal server error"),
         }
     }
@@ -122,8 +151,17 @@ impl IntoResponse for ApiError {
             tracing::error!(error = %self, "request failed");
         }
         let mut res = (status, Json(self.problem())).into_response();
-        res.headers_mut()
-            .insert(header::CONTENT_TYPE, HeaderValue::from_static(PROBLEM_JSON));
+        let headers = res.headers_mut();
+        headers.insert(header::CONTENT_TYPE, HeaderValue::from_static(PROBLEM_JSON));
+        match self {
+            ApiError::Overloaded => {
+                headers.insert(header::RETRY_AFTER, HeaderValue::from_static("1"));
+            }
+            ApiError::Unauthorized => {
+                headers.insert(header::WWW_AUTHENTICATE, HeaderValue::from_static("Bearer"));
+            }
+            _ => {}
+        }
         res
     }
 }

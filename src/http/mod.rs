@@ -15,9 +15,13 @@
 //! | GET | `/v1/scenarios/{id}/stats` | 200 per-cell statistics |
 //! | POST | `/v1/scenarios/{id}/plan` | 200 [`PlanResponse`](crate::planner::PlanResponse) |
 
+pub mod cache;
+pub mod config;
 pub mod error;
 pub mod extract;
 pub mod health;
+pub mod middleware;
+pub mod openapi;
 pub mod plan;
 pub mod scenarios;
 
@@ -26,10 +30,19 @@ use std::collections::btree_map::Entry;
 use std::sync::{Arc, PoisonError, RwLock};
 
 use axum::Router;
+use axum::error_handling::HandleErrorLayer;
 use axum::extract::DefaultBodyLimit;
-use axum::http::{Method, Uri};
+use axum::http::{HeaderValue, Method, Uri, header};
 use axum::routing::{get, post};
+use tower::ServiceBuilder;
+use tower::limit::GlobalConcurrencyLimitLayer;
+use tower_http::cors::{Any, CorsLayer};
+use tower_http::request_id::{MakeRequestUuid, PropagateRequestIdLayer, SetRequestIdLayer};
 use tower_http::trace::TraceLayer;
+
+use self::cache::PlannerCache;
+use self::config::{Config, Settings};
+use crate::store::Store;
 
 use crate::planner::Planner;
 use crate::scenario::{BUILTIN_IDS, builtins};
@@ -39,12 +52,13 @@ pub use error::{ApiError, Problem};
 /// Largest request body accepted, bytes. Large enough for a plan request
 /// with the most targets allowed ([`MAX_TARGETS`](crate::planner::MAX_TARGETS))
 /// written at full precision.
-pub const MAX_BODY_BYTES: usize = 8 * 1024 * 1024;
+pub const MAX_BODY_BYTES: usize = 4 * 1024 * 1024;
 
 /// The registered scenarios, each with its precomputed [`Planner`].
 #[derive(Debug, Default)]
 pub struct Registry {
     planners: RwLock<BTreeMap<String, Arc<Planner>>>,
+    store: Option<Store>,
 }
 
 impl Registry {
@@ -60,9 +74,35 @@ impl Registry {
             .into_iter()
             .map(|s| (s.id.clone(), Arc::new(Planner::new(s))))
             .collect();
-        Self {
+        let registry = Self {
             planners: RwLock::new(planners),
+            store: None,
+        };
+        registry.update_gauge();
+        registry
+    }
+
+    /// The built-ins plus the scenarios kept in `store`, whose statistics
+    /// are rebuilt now (in parallel); new registrations are written there.
+    pub fn with_store(store: Store, stored: Vec<crate::scenario::Scenario>) -> Self {
+        use rayon::prelude::*;
+        let mut registry = Self::with_builtins();
+        let planners: Vec<Planner> = stored.into_par_iter().map(Planner::new).collect();
+        {
+            let mut map = registry.write();
+            for p in planners {
+                tracing::info!(id = %p.scenario.id, precompute_ms = p.precompute_ms, "loaded a stored scenario");
+                map.entry(p.scenario.id.clone())
+                    .or_insert_with(|| Arc::new(p));
+            }
         }
+        registry.store = Some(store);
+        registry.update_gauge();
+        registry
+    }
+
+    fn update_gauge(&self) {
+        metrics::gauge!("vigil_scenarios_loaded").set(self.read().len() as f64);
     }
 
     /// True for the ids of built-in scenarios, which cannot be deleted.
@@ -93,24 +133,48 @@ impl Registry {
     }
 
     /// Registers a planner under its scenario's id unless one is already
-    /// there. Returns the planner now registered under that id and whether
-    /// it is the one passed in (an existing entry is never replaced).
-    pub fn insert(&self, planner: Arc<Planner>) -> (Arc<Planner>, bool) {
-        match self.write().entry(planner.scenario.id.clone()) {
+    /// there, writing it to the store first (so an acknowledged scenario is
+    /// on disk). Returns the planner now registered under that id and
+    /// whether it is the one passed in. Blocking I/O: call it off the async
+    /// workers.
+    pub fn insert(&self, planner: Arc<Planner>) -> Result<(Arc<Planner>, bool), ApiError> {
+        if let Some(existing) = self.get(&planner.scenario.id) {
+            return Ok((existing, false));
+        }
+        if let Some(store) = &self.store {
+            store.save(&planner.scenario).map_err(|e| {
+                ApiError::Internal(format!("storing scenario {}: {e}", planner.scenario.id))
+            })?;
+        }
+        let out = match self.write().entry(planner.scenario.id.clone()) {
             Entry::Occupied(e) => (Arc::clone(e.get()), false),
             Entry::Vacant(e) => (Arc::clone(e.insert(planner)), true),
-        }
+        };
+        self.update_gauge();
+        Ok(out)
     }
 
-    /// Removes a scenario. Fails with [`ApiError::BuiltinScenario`] for a
-    /// built-in and [`ApiError::ScenarioNotFound`] for an unknown id.
+    /// Removes a scenario, from the store too. Fails with
+    /// [`ApiError::BuiltinScenario`] for a built-in and
+    /// [`ApiError::ScenarioNotFound`] for an unknown id. Blocking I/O.
     pub fn remove(&self, id: &str) -> Result<Arc<Planner>, ApiError> {
         if Self::is_builtin(id) {
             return Err(ApiError::BuiltinScenario(id.to_owned()));
         }
-        self.write()
+        if self.get(id).is_none() {
+            return Err(ApiError::ScenarioNotFound(id.to_owned()));
+        }
+        if let Some(store) = &self.store {
+            store
+                .remove(id)
+                .map_err(|e| ApiError::Internal(format!("removing scenario {id}: {e}")))?;
+        }
+        let removed = self
+            .write()
             .remove(id)
-            .ok_or_else(|| ApiError::ScenarioNotFound(id.to_owned()))
+            .ok_or_else(|| ApiError::ScenarioNotFound(id.to_owned()));
+        self.update_gauge();
+        removed
     }
 }
 
@@ -119,20 +183,42 @@ impl Registry {
 pub struct AppState {
     /// The registered scenarios.
     pub registry: Arc<Registry>,
+    /// Planners of scenarios planned inline (`POST /v1/plan`).
+    pub cache: Arc<PlannerCache>,
+    /// Limits, keys and CORS.
+    pub settings: Arc<Settings>,
 }
 
 impl AppState {
-    /// State with the built-in scenarios registered (precomputes them, which
-    /// is CPU work: call it at startup).
+    /// State with the built-in scenarios registered, nothing stored and
+    /// default settings (precomputes the built-ins, which is CPU work: call
+    /// it at startup).
     pub fn new() -> Self {
         Self::with_registry(Registry::with_builtins())
     }
 
-    /// State over a given registry.
+    /// State over a given registry, with default settings.
     pub fn with_registry(registry: Registry) -> Self {
+        Self::with_settings(registry, Settings::default())
+    }
+
+    /// State over a given registry and settings.
+    pub fn with_settings(registry: Registry, settings: Settings) -> Self {
         Self {
             registry: Arc::new(registry),
+            cache: Arc::new(PlannerCache::new(settings.cache_bytes)),
+            settings: Arc::new(settings),
         }
+    }
+
+    /// State from the server's configuration: opens the store under
+    /// `data_dir` and rebuilds the statistics of what it holds.
+    pub fn from_config(config: &Config) -> std::io::Result<Self> {
+        let (store, stored) = Store::open(&config.data_dir)?;
+        Ok(Self::with_settings(
+            Registry::with_store(store, stored),
+            Settings::from(config),
+        ))
     }
 }
 
@@ -142,12 +228,14 @@ impl Default for AppState {
     }
 }
 
-/// The application: every route, problem+json fallbacks for unknown routes
-/// (404) and methods (405), a body limit of [`MAX_BODY_BYTES`] and request
-/// tracing.
+/// The application: every route; on /v1, the API key check (when set), then
+/// load shedding past a global concurrency limit (503) and a time limit
+/// (504); problem+json fallbacks for unknown routes (404) and methods (405);
+/// a body limit of [`MAX_BODY_BYTES`] (413); request metrics, request ids,
+/// tracing and CORS (when configured).
 pub fn router(state: AppState) -> Router {
-    Router::new()
-        .route("/healthz", get(health::healthz))
+    let settings = state.settings.clone();
+    let v1 = Router::new()
         .route(
             "/v1/scenarios",
             get(scenarios::list).post(scenarios::create),
@@ -158,12 +246,57 @@ pub fn router(state: AppState) -> Router {
         )
         .route("/v1/scenarios/{id}/stats", get(scenarios::stats))
         .route("/v1/scenarios/{id}/plan", post(plan::plan))
+        .route("/v1/plan", post(plan::plan_inline))
+        .layer(
+            ServiceBuilder::new()
+                .layer(HandleErrorLayer::new(middleware::overload_error))
+                .load_shed()
+                .layer(GlobalConcurrencyLimitLayer::new(settings.max_in_flight))
+                .timeout(settings.request_timeout),
+        )
+        .layer(axum::middleware::from_fn_with_state(
+            state.clone(),
+            middleware::require_key,
+        ));
+    let app = Router::new()
+        .route("/healthz", get(health::healthz))
+        .route("/openapi.json", get(openapi::serve))
+        .route("/metrics", get(middleware::render))
+        .merge(v1)
         // Must follow the routes: it applies to those already added.
         .method_not_allowed_fallback(method_not_allowed)
         .fallback(not_found)
         .layer(DefaultBodyLimit::max(MAX_BODY_BYTES))
+        .layer(axum::middleware::from_fn(middleware::track))
         .layer(TraceLayer::new_for_http())
-        .with_state(state)
+        .layer(PropagateRequestIdLayer::x_request_id())
+        .layer(SetRequestIdLayer::x_request_id(MakeRequestUuid));
+    let app = match cors(&settings.cors_origins) {
+        Some(layer) => app.layer(layer),
+        None => app,
+    };
+    // Install the metrics recorder before the first request records.
+    middleware::prometheus();
+    app.with_state(state)
+}
+
+/// The CORS layer for the configured origins, if any.
+fn cors(origins: &[String]) -> Option<CorsLayer> {
+    if origins.is_empty() {
+        return None;
+    }
+    let layer = CorsLayer::new()
+        .allow_methods([Method::GET, Method::POST, Method::DELETE])
+        .allow_headers([header::CONTENT_TYPE, header::AUTHORIZATION]);
+    Some(if origins.iter().any(|o| o == "*") {
+        layer.allow_origin(Any)
+    } else {
+        let list: Vec<HeaderValue> = origins
+            .iter()
+            .filter_map(|o| HeaderValue::from_str(o).ok())
+            .collect();
+        layer.allow_origin(list)
+    })
 }
 
 async fn not_found(uri: Uri) -> ApiError {

@@ -5,11 +5,42 @@ use axum::extract::State;
 use super::AppState;
 use super::error::ApiError;
 use super::extract::{Json, Path};
-use crate::planner::{PlanRequest, PlanResponse};
+use super::openapi::{self as doc, examples};
+use std::sync::Arc;
+
+use crate::planner::{PlanRequest, PlanResponse, Planner};
+use crate::scenario::{Scenario, ScenarioSpec};
 
 /// `POST /v1/scenarios/{id}/plan`, body [`PlanRequest`] → 200
 /// [`PlanResponse`]; 404 for an unknown scenario (checked before the body),
 /// 400 for a malformed body, 422 for a value out of bounds.
+#[utoipa::path(
+    post,
+    path = "/v1/scenarios/{id}/plan",
+    operation_id = "planScenario",
+    tag = "planning",
+    summary = "Plan the sensors' next T steps",
+    description = "Plans coordinated T-step paths for the sensors that maximise the expected \
+        number of distinct targets detected, given the targets reported now (and optionally the \
+        sensors' past positions). Positions are snapped to the scenario's lattice. The scenario \
+        is looked up before the body is read, so an unknown id is 404 whatever the body.",
+    params(("id" = String, Path, description = doc::SCENARIO_ID, example = "paper-v10")),
+    request_body(content = PlanRequest, description = "Sensors, targets and options.",
+        examples(
+            ("paper-v10" = (summary = "Three sensors and three targets on paper-v10",
+                value = json!(examples::plan_request()))),
+            ("minimal" = (summary = "One sensor, no targets, every option by default",
+                value = json!({"sensors": [{"id": "a", "x": 150.0, "y": 150.0}]}))),
+        )),
+    responses(
+        (status = 200, description = "One plan per sensor, in request order.", body = PlanResponse,
+            example = json!(examples::plan_response())),
+        (status = 400, response = doc::MalformedBody),
+        (status = 404, response = doc::ScenarioNotFound),
+        (status = 413, response = doc::PayloadTooLarge),
+        (status = 422, response = doc::InvalidPlanRequest),
+    )
+)]
 pub async fn plan(
     State(state): State<AppState>,
     Path(id): Path<String>,
@@ -20,6 +51,94 @@ pub async fn plan(
         .get(&id)
         .ok_or(ApiError::ScenarioNotFound(id))?;
     let Json(req) = body?;
+    let res = tokio::task::spawn_blocking(move || planner.plan_request(&req)).await??;
+    Ok(Json(res))
+}
+
+/// `POST /v1/plan`: the body of `/v1/scenarios/{id}/plan` plus either
+/// `"scenario_id"` (a registered or cached scenario) or an inline
+/// `"scenario"` (a ScenarioSpec). Inline scenarios are precomputed once and
+/// kept in a memory-bounded LRU cache, so a replica needs nothing from
+/// another to serve any request.
+#[utoipa::path(
+    post,
+    path = "/v1/plan",
+    operation_id = "plan",
+    tag = "planning",
+    summary = "Plan in a scenario named or sent inline",
+    description = "The same planning as `POST /v1/scenarios/{id}/plan`, with the scenario in the \
+        body: either `scenario_id` (a registered scenario, or one sent inline before) or \
+        `scenario` (a spec, precomputed on first use and kept in a memory-bounded LRU cache, \
+        not registered). Exactly one of the two is required.",
+    request_body(content = doc::InlinePlanRequest, description = "Scenario, sensors, targets and options.",
+        examples(
+            ("by-id" = (summary = "paper-v10 by id", value = json!(examples::plan_request_by_id()))),
+            ("inline" = (summary = "A scenario sent inline", value = json!(examples::plan_request_inline()))),
+        )),
+    responses(
+        (status = 200, description = "One plan per sensor, in request order.", body = PlanResponse,
+            example = json!(examples::plan_response())),
+        (status = 400, response = doc::MalformedBody),
+        (status = 404, response = doc::ScenarioNotFound),
+        (status = 413, response = doc::PayloadTooLarge),
+        (status = 422, response = doc::InvalidInlinePlanRequest),
+    )
+)]
+pub async fn plan_inline(
+    State(state): State<AppState>,
+    Json(body): Json<serde_json::Value>,
+) -> Result<Json<PlanResponse>, ApiError> {
+    let serde_json::Value::Object(mut fields) = body else {
+        return Err(ApiError::MalformedBody(
+            "the body must be a JSON object".into(),
+        ));
+    };
+    let scenario_id = fields.remove("scenario_id");
+    let inline = fields.remove("scenario");
+    let req: PlanRequest = serde_json::from_value(serde_json::Value::Object(fields))
+        .map_err(|e| ApiError::MalformedBody(e.to_string()))?;
+    let planner: Arc<Planner> = match (scenario_id, inline) {
+        (Some(serde_json::Value::String(id)), None) => state
+            .registry
+            .get(&id)
+            .or_else(|| state.cache.get(&id))
+            .ok_or(ApiError::ScenarioNotFound(id))?,
+        (Some(_), None) => {
+            return Err(ApiError::MalformedBody(
+                "scenario_id must be a string".into(),
+            ));
+        }
+        (None, Some(spec)) => {
+            let spec: ScenarioSpec = serde_json::from_value(spec)
+                .map_err(|e| ApiError::MalformedBody(format!("scenario: {e}")))?;
+            let scenario = Scenario::new(spec).map_err(|mut e| {
+                e.field = format!("scenario.{}", e.field);
+                e
+            })?;
+            match state
+                .registry
+                .get(&scenario.id)
+                .or_else(|| state.cache.get(&scenario.id))
+            {
+                Some(p) => p,
+                None => {
+                    let cache = state.cache.clone();
+                    tokio::task::spawn_blocking(move || {
+                        let planner = Planner::new(scenario);
+                        metrics::histogram!("vigil_precompute_seconds")
+                            .record(planner.precompute_ms / 1e3);
+                        cache.insert(Arc::new(planner))
+                    })
+                    .await?
+                }
+            }
+        }
+        _ => {
+            return Err(ApiError::Unprocessable(
+                "exactly one of `scenario_id` and `scenario` is required".into(),
+            ));
+        }
+    };
     let res = tokio::task::spawn_blocking(move || planner.plan_request(&req)).await??;
     Ok(Json(res))
 }

@@ -7,15 +7,17 @@ use axum::extract::State;
 use axum::http::{HeaderValue, StatusCode, header};
 use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};
+use utoipa::ToSchema;
 
 use super::AppState;
 use super::error::ApiError;
 use super::extract::{Json, Path};
+use super::openapi::{self as doc, examples};
 use crate::planner::Planner;
 use crate::scenario::{Scenario, ScenarioSpec};
 
 /// Size of a scenario's lattice.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
 pub struct Grid {
     /// Columns.
     pub cols: i32,
@@ -24,7 +26,7 @@ pub struct Grid {
 }
 
 /// Scalar results of a scenario's precomputation.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, ToSchema)]
 pub struct SummaryStats {
     /// Stationary expected number of targets inside the zone.
     pub expected_targets_in_zone: f64,
@@ -33,7 +35,7 @@ pub struct SummaryStats {
 }
 
 /// A registered scenario, as `GET /v1/scenarios/{id}` returns it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
 pub struct ScenarioSummary {
     /// Scenario id.
     pub id: String,
@@ -63,7 +65,7 @@ impl From<&Planner> for ScenarioSummary {
 }
 
 /// Body of `GET /v1/scenarios`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
 pub struct ScenarioList {
     /// Every registered scenario, sorted by id.
     pub scenarios: Vec<ScenarioSummary>,
@@ -72,7 +74,10 @@ pub struct ScenarioList {
 /// Body of `GET /v1/scenarios/{id}/stats`: per-cell statistics, row-major
 /// (`row·cols + col`). Borrows from the planner, so large lattices are not
 /// copied before serialization.
-#[derive(Debug, Clone, Copy, Serialize)]
+#[derive(Debug, Clone, Copy, Serialize, ToSchema)]
+#[schema(
+    description = "Per-cell statistics of a scenario, each array row-major (`row·cols + col`)."
+)]
 pub struct ScenarioStats<'a> {
     /// Columns.
     pub cols: i32,
@@ -109,6 +114,18 @@ fn lookup(state: &AppState, id: String) -> Result<Arc<Planner>, ApiError> {
 }
 
 /// `GET /v1/scenarios` → 200 [`ScenarioList`].
+#[utoipa::path(
+    get,
+    path = "/v1/scenarios",
+    operation_id = "listScenarios",
+    tag = "scenarios",
+    summary = "List scenarios",
+    description = "Every registered scenario, built-in and client-registered, sorted by id.",
+    responses(
+        (status = 200, description = "The registered scenarios.", body = ScenarioList,
+            example = json!(examples::scenario_list())),
+    )
+)]
 pub async fn list(State(state): State<AppState>) -> Json<ScenarioList> {
     let scenarios = state
         .registry
@@ -123,6 +140,28 @@ pub async fn list(State(state): State<AppState>) -> Json<ScenarioList> {
 /// [`ScenarioSummary`] and a `Location` header when the scenario is new, 200
 /// with the registered one when its id already exists; 422 for an invalid
 /// spec.
+#[utoipa::path(
+    post,
+    path = "/v1/scenarios",
+    operation_id = "createScenario",
+    tag = "scenarios",
+    summary = "Register a scenario",
+    description = "Validates the spec, precomputes its per-cell statistics and registers it under \
+        an id derived from the canonical spec (`s-` and 16 hex digits), so posting the same spec \
+        again is idempotent: 201 the first time, 200 with the registered scenario after.",
+    request_body(content = ScenarioSpec, description = "The scenario.",
+        example = json!(examples::small_spec())),
+    responses(
+        (status = 201, description = "Registered: the new scenario.", body = ScenarioSummary,
+            headers(("Location" = String, description = "`/v1/scenarios/{id}` of the new scenario.")),
+            example = json!(examples::small_summary())),
+        (status = 200, description = "A scenario with this canonical spec was already registered: that one.",
+            body = ScenarioSummary, example = json!(examples::small_summary())),
+        (status = 400, response = doc::MalformedBody),
+        (status = 413, response = doc::PayloadTooLarge),
+        (status = 422, response = doc::InvalidScenario),
+    )
+)]
 pub async fn create(
     State(state): State<AppState>,
     Json(spec): Json<ScenarioSpec>,
@@ -131,10 +170,16 @@ pub async fn create(
     if let Some(existing) = state.registry.get(&scenario.id) {
         return Ok(Json(ScenarioSummary::from(existing.as_ref())).into_response());
     }
-    let planner = tokio::task::spawn_blocking(move || Planner::new(scenario)).await?;
-    // A concurrent identical request may have registered it meanwhile; the
-    // first one stays.
-    let (planner, created) = state.registry.insert(Arc::new(planner));
+    // Precompute and store off the async workers; a 2xx means it is on disk.
+    let registry = state.registry.clone();
+    let (planner, created) = tokio::task::spawn_blocking(move || {
+        let planner = Planner::new(scenario);
+        metrics::histogram!("vigil_precompute_seconds").record(planner.precompute_ms / 1e3);
+        // A concurrent identical request may have registered it meanwhile;
+        // the first one stays.
+        registry.insert(Arc::new(planner))
+    })
+    .await??;
     let body = Json(ScenarioSummary::from(planner.as_ref()));
     if !created {
         return Ok(body.into_response());
@@ -145,6 +190,20 @@ pub async fn create(
 }
 
 /// `GET /v1/scenarios/{id}` → 200 [`ScenarioSummary`]; 404 if unknown.
+#[utoipa::path(
+    get,
+    path = "/v1/scenarios/{id}",
+    operation_id = "getScenario",
+    tag = "scenarios",
+    summary = "Read a scenario",
+    params(("id" = String, Path, description = doc::SCENARIO_ID, example = "paper-v10")),
+    responses(
+        (status = 200, description = "The scenario.", body = ScenarioSummary,
+            example = json!(examples::paper_v10_summary())),
+        (status = 400, response = doc::BadPath),
+        (status = 404, response = doc::ScenarioNotFound),
+    )
+)]
 pub async fn get(
     State(state): State<AppState>,
     Path(id): Path<String>,
@@ -154,16 +213,48 @@ pub async fn get(
 }
 
 /// `DELETE /v1/scenarios/{id}` → 204; 409 for a built-in, 404 if unknown.
+#[utoipa::path(
+    delete,
+    path = "/v1/scenarios/{id}",
+    operation_id = "deleteScenario",
+    tag = "scenarios",
+    summary = "Delete a scenario",
+    description = "Removes a client-registered scenario. Built-in scenarios cannot be deleted.",
+    params(("id" = String, Path, description = doc::SCENARIO_ID, example = "paper-v10")),
+    responses(
+        (status = 204, description = "Deleted."),
+        (status = 400, response = doc::BadPath),
+        (status = 404, response = doc::ScenarioNotFound),
+        (status = 409, response = doc::BuiltinScenario),
+    )
+)]
 pub async fn delete(
     State(state): State<AppState>,
     Path(id): Path<String>,
 ) -> Result<StatusCode, ApiError> {
-    state.registry.remove(&id)?;
+    let registry = state.registry.clone();
+    tokio::task::spawn_blocking(move || registry.remove(&id)).await??;
     Ok(StatusCode::NO_CONTENT)
 }
 
 /// `GET /v1/scenarios/{id}/stats` → 200 [`ScenarioStats`]; 404 if unknown.
 /// Serialized on the blocking pool, as a large lattice gives a large body.
+#[utoipa::path(
+    get,
+    path = "/v1/scenarios/{id}/stats",
+    operation_id = "getScenarioStats",
+    tag = "scenarios",
+    summary = "Per-cell statistics of a scenario",
+    description = "The precomputed statistics of every cell, row-major (`row·cols + col`). \
+        The body has `3·cols·rows` numbers: large for a fine lattice.",
+    params(("id" = String, Path, description = doc::SCENARIO_ID, example = "paper-v10")),
+    responses(
+        (status = 200, description = "The statistics.", body = ScenarioStats,
+            example = json!(examples::stats())),
+        (status = 400, response = doc::BadPath),
+        (status = 404, response = doc::ScenarioNotFound),
+    )
+)]
 pub async fn stats(
     State(state): State<AppState>,
     Path(id): Path<String>,

@@ -4,6 +4,9 @@
 #![allow(clippy::unwrap_used)]
 
 mod errors;
+mod fuzz;
 mod helpers;
+mod openapi;
+mod ops;
 mod plan;
 mod scenarios;

@@ -1,0 +1,96 @@
+//! Server configuration: every option has a flag and an environment
+//! variable (the flag wins).
+
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::time::Duration;
+
+/// Log output format.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum LogFormat {
+    /// Human-readable lines.
+    Human,
+    /// One JSON object per line.
+    Json,
+}
+
+/// `vigil-server`'s configuration.
+#[derive(Debug, Clone, clap::Parser)]
+#[command(
+    name = "vigil-server",
+    version,
+    about = "Serves the Vigil planning API over HTTP"
+)]
+pub struct Config {
+    /// Address to listen on.
+    #[arg(long, env = "VIGIL_BIND", default_value = "127.0.0.1:8080")]
+    pub bind: SocketAddr,
+    /// Directory where registered scenarios are kept (created if missing).
+    #[arg(long, env = "VIGIL_DATA_DIR", default_value = "./vigil-data")]
+    pub data_dir: PathBuf,
+    /// When set, every /v1 endpoint requires `Authorization: Bearer <key>`.
+    #[arg(long, env = "VIGIL_API_KEY", hide_env_values = true)]
+    pub api_key: Option<String>,
+    /// Origins allowed by CORS, comma-separated (`*` for any). CORS is off
+    /// when empty.
+    #[arg(long, env = "VIGIL_CORS_ORIGINS", value_delimiter = ',')]
+    pub cors_origins: Vec<String>,
+    /// Log format.
+    #[arg(long, env = "VIGIL_LOG_FORMAT", value_enum, default_value_t = LogFormat::Human)]
+    pub log_format: LogFormat,
+    /// Most /v1 requests handled at once; past it, requests are shed at once
+    /// with 503 and Retry-After.
+    #[arg(long, env = "VIGIL_MAX_IN_FLIGHT", default_value_t = 64)]
+    pub max_in_flight: usize,
+    /// Time limit of a /v1 request, milliseconds (504 past it).
+    #[arg(long, env = "VIGIL_REQUEST_TIMEOUT_MS", default_value_t = 30_000)]
+    pub request_timeout_ms: u64,
+    /// Memory for statistics of scenarios planned inline through /v1/plan,
+    /// MiB (least recently used are evicted).
+    #[arg(long, env = "VIGIL_CACHE_MB", default_value_t = 512)]
+    pub cache_mb: u64,
+}
+
+/// The settings the router needs.
+#[derive(Debug, Clone)]
+pub struct Settings {
+    /// Required bearer key of /v1 endpoints.
+    pub api_key: Option<String>,
+    /// CORS origins (empty: CORS off).
+    pub cors_origins: Vec<String>,
+    /// Concurrency limit of /v1.
+    pub max_in_flight: usize,
+    /// Time limit of a /v1 request.
+    pub request_timeout: Duration,
+    /// Memory bound of the inline-scenario cache, bytes.
+    pub cache_bytes: usize,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            api_key: None,
+            cors_origins: Vec::new(),
+            max_in_flight: 64,
+            request_timeout: Duration::from_secs(30),
+            cache_bytes: 512 << 20,
+        }
+    }
+}
+
+impl From<&Config> for Settings {
+    fn from(c: &Config) -> Self {
+        Settings {
+            api_key: c.api_key.clone().filter(|k| !k.is_empty()),
+            cors_origins: c
+                .cors_origins
+                .iter()
+                .filter(|o| !o.is_empty())
+                .cloned()
+                .collect(),
+            max_in_flight: c.max_in_flight.max(1),
+            request_timeout: Duration::from_millis(c.request_timeout_ms.max(1)),
+            cache_bytes: usize::try_from(c.cache_mb.saturating_mul(1 << 20)).unwrap_or(usize::MAX),
+        }
+    }
+}

@@ -1,0 +1,532 @@
+//! The OpenAPI 3.1 description of the API, generated from the handlers'
+//! `#[utoipa::path]` attributes and the wire types' `ToSchema` derives.
+//!
+//! [`spec`] builds it, [`serve`] answers `GET /openapi.json` with it, and the
+//! same document is checked in at `openapi/openapi.json` (the API tests fail
+//! when the two differ; `VIGIL_UPDATE_OPENAPI=1 cargo test --test api openapi`
+//! rewrites the file). The `info` block is pinned here, not taken from the
+//! crate's metadata, so a version bump alone does not change the document.
+
+use std::sync::LazyLock;
+
+use axum::http::{HeaderValue, header};
+use axum::response::IntoResponse;
+use utoipa::openapi::security::{HttpAuthScheme, HttpBuilder, SecurityRequirement, SecurityScheme};
+use utoipa::openapi::{Ref, RefOr};
+use utoipa::{Modify, OpenApi, ToResponse, ToSchema};
+
+use super::error::{ApiError, Problem};
+use super::{health, middleware, plan, scenarios};
+use crate::coordination::Coordination;
+use crate::planner::{EstimatorKind, Observed, PositionIn, SensorIn, TargetIn};
+use crate::scenario::{ScenarioSpec, ValidationError};
+
+/// Description of the whole API, the `info.description` of the document.
+const DESCRIPTION: &str = "\
+Plans where mobile surveillance sensors should move over the next T steps to \
+detect the most targets, after Krishna, Hexmoor and Sogani, *A T-Step Ahead \
+Optimal Target Detection Algorithm for a Multi Sensor Surveillance System*.
+
+A **scenario** is the model: a rectangular zone divided into square cells, \
+point sources of targets outside it, the sensors' field of view and the \
+targets' speed. Registering one precomputes its per-cell statistics; the \
+built-in scenarios `paper-v10` and `paper-v15` are the paper's setting with \
+target speeds 10 and 15. A **plan** request gives the sensors' positions and \
+the targets they report now, and gets back coordinated T-step paths.
+
+Every error is an RFC 9457 problem (`application/problem+json`, schema \
+`Problem`) whose `type` names the kind of error.";
+
+/// The API's OpenAPI document.
+#[derive(OpenApi)]
+#[openapi(
+    info(
+        title = "Vigil planning API",
+        version = "1",
+        description = DESCRIPTION,
+        license(name = "MIT OR Apache-2.0"),
+    ),
+    paths(
+        health::healthz,
+        serve,
+        middleware::render,
+        scenarios::list,
+        scenarios::create,
+        scenarios::get,
+        scenarios::delete,
+        scenarios::stats,
+        plan::plan,
+        plan::plan_inline,
+    ),
+    components(
+        schemas(Problem),
+        responses(
+            MalformedBody,
+            BadPath,
+            PayloadTooLarge,
+            ScenarioNotFound,
+            BuiltinScenario,
+            InvalidScenario,
+            InvalidPlanRequest,
+            InvalidInlinePlanRequest,
+            Unauthorized,
+            Overloaded,
+            Timeout,
+        )
+    ),
+    modifiers(&V1Stack),
+    tags(
+        (name = "health", description = "Liveness."),
+        (name = "scenarios", description = "Register, read and delete scenarios."),
+        (name = "planning", description = "Plan sensors' paths."),
+        (name = "meta", description = "This document and the server's metrics."),
+    )
+)]
+pub struct ApiDoc;
+
+/// What the `/v1` stack adds to each of its operations: the optional bearer
+/// key (401) and the overload (503) and time limit (504) errors.
+struct V1Stack;
+
+impl Modify for V1Stack {
+    fn modify(&self, doc: &mut utoipa::openapi::OpenApi) {
+        doc.components
+            .get_or_insert_with(Default::default)
+            .add_security_scheme(
+                BEARER,
+                SecurityScheme::Http(
+                    HttpBuilder::new()
+                        .scheme(HttpAuthScheme::Bearer)
+                        .description(Some(
+                            "The server's API key, as `Authorization: Bearer <key>`. Required by \
+                             every `/v1` endpoint when the server is started with `--api-key` \
+                             (`VIGIL_API_KEY`); without a key, none is needed.",
+                        ))
+                        .build(),
+                ),
+            );
+        let v1 = doc
+            .paths
+            .paths
+            .iter_mut()
+            .filter(|(path, _)| path.starts_with("/v1/"));
+        for (_, item) in v1 {
+            let operations = [
+                &mut item.get,
+                &mut item.put,
+                &mut item.post,
+                &mut item.delete,
+                &mut item.patch,
+            ];
+            for op in operations.into_iter().flatten() {
+                for (status, response) in [
+                    ("401", "Unauthorized"),
+                    ("503", "Overloaded"),
+                    ("504", "Timeout"),
+                ] {
+                    op.responses
+                        .responses
+                        .entry(status.to_owned())
+                        .or_insert_with(|| RefOr::Ref(Ref::from_response_name(response)));
+                }
+                // The key is optional: `{}` is the anonymous alternative.
+                op.security = Some(vec![
+                    SecurityRequirement::new(BEARER, Vec::<String>::new()),
+                    SecurityRequirement::default(),
+                ]);
+            }
+        }
+    }
+}
+
+/// Name of the bearer security scheme.
+const BEARER: &str = "bearer";
+
+/// The OpenAPI document of the API.
+pub fn spec() -> utoipa::openapi::OpenApi {
+    ApiDoc::openapi()
+}
+
+/// The document as served and checked in: pretty-printed JSON with a
+/// trailing newline.
+pub fn spec_json() -> String {
+    // Serializing plain data to a string cannot fail; keep the body JSON
+    // regardless.
+    let mut json = spec().to_pretty_json().unwrap_or_else(|e| {
+        serde_json::json!({"error": format!("cannot serialize the OpenAPI document: {e}")})
+            .to_string()
+    });
+    json.push('\n');
+    json
+}
+
+static SPEC_JSON: LazyLock<String> = LazyLock::new(spec_json);
+
+/// `GET /openapi.json` → 200, this document.
+#[utoipa::path(
+    get,
+    path = "/openapi.json",
+    operation_id = "getOpenApi",
+    tag = "meta",
+    summary = "This OpenAPI document",
+    responses(
+        (status = 200, description = "The OpenAPI 3.1 document of the API.",
+            body = Object, content_type = "application/json"),
+    )
+)]
+pub async fn serve() -> impl IntoResponse {
+    (
+        [(
+            header::CONTENT_TYPE,
+            HeaderValue::from_static("application/json"),
+        )],
+        SPEC_JSON.as_str(),
+    )
+}
+
+/// Body of `POST /v1/plan`: the body of `POST /v1/scenarios/{id}/plan` plus
+/// exactly one of `scenario_id` and `scenario`.
+#[derive(Debug, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct InlinePlanRequest {
+    /// Id of a registered scenario, or of one sent inline before.
+    #[schema(example = "paper-v10")]
+    pub scenario_id: Option<String>,
+    /// The scenario itself; precomputed on first use and cached.
+    pub scenario: Option<ScenarioSpec>,
+    /// Sensors now.
+    #[schema(min_items = 1, max_items = 256)]
+    pub sensors: Vec<SensorIn>,
+    /// Targets reported now.
+    #[serde(default)]
+    #[schema(max_items = 20000)]
+    pub targets: Vec<TargetIn>,
+    /// Sensors' positions 1, 2, … steps ago.
+    #[schema(max_items = 32)]
+    pub history: Option<Vec<Vec<PositionIn>>>,
+    /// Horizon T; the scenario's by default.
+    #[schema(minimum = 1, maximum = 12)]
+    pub horizon: Option<usize>,
+    /// Estimator; `exact` by default.
+    pub estimator: Option<EstimatorKind>,
+    /// Coordination; `priority` by default.
+    pub coordination: Option<Coordination>,
+    /// What the reported targets cover; `sensors` by default.
+    pub observed: Option<Observed>,
+    /// Include the search values in the response.
+    pub explain: Option<bool>,
+}
+
+/// Description of the `{id}` path parameter.
+pub const SCENARIO_ID: &str = "Scenario id: a built-in (`paper-v10`, `paper-v15`) or one returned by \
+    `POST /v1/scenarios`.";
+
+fn problem(e: ApiError) -> Problem {
+    e.problem()
+}
+
+fn invalid(field: &str, message: &str) -> Problem {
+    problem(ApiError::Validation(ValidationError::new(field, message)))
+}
+
+/// Malformed request: the body is not acceptable JSON for the endpoint (a
+/// syntax error, a missing or wrong `Content-Type`, a missing or unknown
+/// field, a value of the wrong type), or a path parameter cannot be decoded.
+#[derive(Debug, ToResponse)]
+#[response(
+    content_type = "application/problem+json",
+    examples(
+        ("syntax" = (summary = "Not JSON", value = json!(problem(ApiError::MalformedBody(
+            "Failed to parse the request body as JSON: EOF while parsing an object at line 1 column 1".to_owned()
+        ))))),
+        ("content-type" = (summary = "No JSON content type", value = json!(problem(
+            ApiError::MalformedBody("expected a request with `Content-Type: application/json`".to_owned())
+        )))),
+        ("missing-field" = (summary = "A required field is missing", value = json!(problem(
+            ApiError::MalformedBody(
+                "Failed to deserialize the JSON body into the target type: missing field `sensors` at line 1 column 2".to_owned()
+            )
+        )))),
+    )
+)]
+pub struct MalformedBody(pub Problem);
+
+/// The `{id}` path parameter cannot be decoded (percent-encoded bytes that
+/// are not UTF-8, e.g. `%FF`).
+#[derive(Debug, ToResponse)]
+#[response(
+    content_type = "application/problem+json",
+    example = json!(problem(ApiError::BadPath(
+        "Invalid URL: Invalid UTF-8 in `id`".to_owned()
+    )))
+)]
+pub struct BadPath(pub Problem);
+
+/// The request body is larger than the server's limit.
+#[derive(Debug, ToResponse)]
+#[response(
+    content_type = "application/problem+json",
+    example = json!(problem(ApiError::PayloadTooLarge("Failed to buffer the request body: length limit exceeded".to_owned())))
+)]
+pub struct PayloadTooLarge(pub Problem);
+
+/// No scenario has this id.
+#[derive(Debug, ToResponse)]
+#[response(
+    content_type = "application/problem+json",
+    example = json!(problem(ApiError::ScenarioNotFound("nope".to_owned())))
+)]
+pub struct ScenarioNotFound(pub Problem);
+
+/// The scenario is built in and cannot be deleted.
+#[derive(Debug, ToResponse)]
+#[response(
+    content_type = "application/problem+json",
+    example = json!(problem(ApiError::BuiltinScenario("paper-v10".to_owned())))
+)]
+pub struct BuiltinScenario(pub Problem);
+
+/// The spec is well-formed but a value is outside its bounds. `detail` starts
+/// with the JSON path of the offending field and a colon.
+#[derive(Debug, ToResponse)]
+#[response(
+    content_type = "application/problem+json",
+    examples(
+        ("cell-size" = (summary = "Cells do not tile the zone", value = json!(invalid(
+            "zone.width", "100 is not a whole multiple of cell_size 7"
+        )))),
+        ("source-inside" = (summary = "A source inside the zone", value = json!(invalid(
+            "sources[0]",
+            "(50, 50) is inside the zone [0,100]×[0,100]; sources must be strictly outside"
+        )))),
+        ("horizon" = (summary = "Horizon out of range", value = json!(invalid(
+            "horizon", "must be in 1..=12, got 13"
+        )))),
+    )
+)]
+pub struct InvalidScenario(pub Problem);
+
+/// The request is well-formed but a value is outside its bounds or the
+/// scenario's zone. `detail` starts with the JSON path of the offending field
+/// and a colon.
+#[derive(Debug, ToResponse)]
+#[response(
+    content_type = "application/problem+json",
+    examples(
+        ("no-sensors" = (summary = "No sensor", value = json!(invalid(
+            "sensors", "at least one sensor is required"
+        )))),
+        ("outside" = (summary = "A sensor outside the zone", value = json!(invalid(
+            "sensors[0]", "(400, 10) is outside the zone [0,300]×[0,300]"
+        )))),
+        ("duplicate" = (summary = "Two sensors with one id", value = json!(invalid(
+            "sensors[1].id", "duplicate sensor id"
+        )))),
+        ("horizon" = (summary = "Horizon out of range", value = json!(invalid(
+            "horizon", "must be in 1..=12, got 0"
+        )))),
+    )
+)]
+pub struct InvalidPlanRequest(pub Problem);
+
+/// The request is well-formed but a value is outside its bounds (fields of
+/// an inline scenario are prefixed with `scenario.`), or it gives both or
+/// neither of `scenario_id` and `scenario`.
+#[derive(Debug, ToResponse)]
+#[response(
+    content_type = "application/problem+json",
+    examples(
+        ("one-of" = (summary = "Neither scenario_id nor scenario", value = json!(problem(
+            ApiError::Unprocessable("exactly one of `scenario_id` and `scenario` is required".to_owned())
+        )))),
+        ("scenario" = (summary = "An invalid inline scenario", value = json!(invalid(
+            "scenario.zone.width", "100 is not a whole multiple of cell_size 7"
+        )))),
+        ("outside" = (summary = "A sensor outside the zone", value = json!(invalid(
+            "sensors[0]", "(400, 10) is outside the zone [0,300]×[0,300]"
+        )))),
+    )
+)]
+pub struct InvalidInlinePlanRequest(pub Problem);
+
+/// The server requires an API key and the request has none, or a wrong one.
+#[derive(Debug, ToResponse)]
+#[response(
+    content_type = "application/problem+json",
+    headers(("WWW-Authenticate" = String, description = "`Bearer`.")),
+    example = json!(problem(ApiError::Unauthorized))
+)]
+pub struct Unauthorized(pub Problem);
+
+/// The server is handling as many `/v1` requests as it allows: the request
+/// was shed at once, without being handled. Retry after the delay given.
+#[derive(Debug, ToResponse)]
+#[response(
+    content_type = "application/problem+json",
+    headers(("Retry-After" = String, description = "Seconds to wait before retrying.")),
+    example = json!(problem(ApiError::Overloaded))
+)]
+pub struct Overloaded(pub Problem);
+
+/// The request took longer than the server's time limit.
+#[derive(Debug, ToResponse)]
+#[response(
+    content_type = "application/problem+json",
+    example = json!(problem(ApiError::Timeout))
+)]
+pub struct Timeout(pub Problem);
+
+/// Example bodies used in the document. Ids and canonical specs come from
+/// the code; computed numbers are from a real run, rounded.
+pub mod examples {
+    use serde_json::{Value, json};
+
+    use crate::scenario::{Scenario, ScenarioSpec, builtins};
+
+    /// A small scenario: a 100×100 zone of 10-unit cells, two sources.
+    pub fn small_spec() -> Value {
+        json!({
+            "name": "small",
+            "zone": {"width": 100.0, "height": 100.0},
+            "cell_size": 10.0,
+            "fov": {"shape": "square", "half_width": 15.0},
+            "target_speed": 10.0,
+            "sources": [
+                {"x": -1.0, "y": 50.0, "rate": 0.5},
+                {"x": 50.0, "y": 101.0, "rate": 0.25}
+            ]
+        })
+    }
+
+    /// Id and canonical spec of a spec, as the server derives them.
+    fn registered(spec: Value) -> (String, Value) {
+        serde_json::from_value::<ScenarioSpec>(spec)
+            .ok()
+            .and_then(|spec| Scenario::new(spec).ok())
+            .map_or_else(
+                || ("s-0000000000000000".to_owned(), Value::Null),
+                |s| (s.id, json!(s.spec)),
+            )
+    }
+
+    /// The summary of [`small_spec`] once registered.
+    pub fn small_summary() -> Value {
+        let (id, spec) = registered(small_spec());
+        json!({
+            "id": id,
+            "spec": spec,
+            "grid": {"cols": 10, "rows": 10},
+            "summary": {"expected_targets_in_zone": 5.4993, "precompute_ms": 0.13}
+        })
+    }
+
+    /// The summary of `paper-v10`.
+    pub fn paper_v10_summary() -> Value {
+        let spec = builtins()
+            .into_iter()
+            .find(|s| s.id == "paper-v10")
+            .map_or(Value::Null, |s| json!(s.spec));
+        json!({
+            "id": "paper-v10",
+            "spec": spec,
+            "grid": {"cols": 30, "rows": 30},
+            "summary": {"expected_targets_in_zone": 53.0358, "precompute_ms": 1.62}
+        })
+    }
+
+    /// A list with `paper-v10` and a registered scenario.
+    pub fn scenario_list() -> Value {
+        json!({"scenarios": [paper_v10_summary(), small_summary()]})
+    }
+
+    /// Statistics of a 3×2 lattice (a 30×20 zone of 10-unit cells, circular
+    /// field of view of radius 10, one source west of it).
+    pub fn stats() -> Value {
+        json!({
+            "cols": 3,
+            "rows": 2,
+            "cell_size": 10.0,
+            "lambda_hat": [0.4417, 0.2028, 0.1147, 0.4417, 0.2028, 0.1147],
+            "escape_time": [1.9364, 2.6036, 2.3088, 1.9364, 2.6036, 2.3088],
+            "d_hat": [0.8553, 0.5279, 0.2647, 0.8553, 0.5279, 0.2647]
+        })
+    }
+
+    /// A plan request on `paper-v10`: three sensors, three targets.
+    pub fn plan_request() -> Value {
+        json!({
+            "sensors": [
+                {"id": "a", "x": 55.0, "y": 55.0},
+                {"id": 7, "x": 150.0, "y": 150.0},
+                {"id": "c", "x": 245.0, "y": 60.0}
+            ],
+            "targets": [
+                {"id": "t1", "x": 60.0, "y": 40.0, "vx": 10.0, "vy": 0.0},
+                {"x": 140.0, "y": 160.0, "vx": -3.0, "vy": 9.0},
+                {"id": 3, "x": 250.0, "y": 70.0, "vx": 0.0, "vy": -10.0}
+            ]
+        })
+    }
+
+    /// [`plan_request`] for `POST /v1/plan`, naming the scenario.
+    pub fn plan_request_by_id() -> Value {
+        let mut req = plan_request();
+        req["scenario_id"] = json!("paper-v10");
+        req
+    }
+
+    /// A `POST /v1/plan` request with its scenario inline.
+    pub fn plan_request_inline() -> Value {
+        json!({
+            "scenario": small_spec(),
+            "sensors": [{"id": "a", "x": 50.0, "y": 50.0}],
+            "targets": [{"x": 20.0, "y": 45.0, "vx": 10.0, "vy": 0.0}],
+            "horizon": 2
+        })
+    }
+
+    fn cell(col: i32, row: i32) -> Value {
+        json!({
+            "col": col,
+            "row": row,
+            "x": (f64::from(col) + 0.5) * 10.0,
+            "y": (f64::from(row) + 0.5) * 10.0
+        })
+    }
+
+    /// The response to [`plan_request`].
+    pub fn plan_response() -> Value {
+        json!({
+            "scenario": "paper-v10",
+            "horizon": 3,
+            "estimator": "exact",
+            "coordination": "priority",
+            "plans": [
+                {
+                    "sensor": "a",
+                    "priority": 1,
+                    "start": cell(5, 5),
+                    "path": [cell(6, 4), cell(7, 3), cell(8, 2)],
+                    "expected_detections": 6.9032
+                },
+                {
+                    "sensor": 7,
+                    "priority": 3,
+                    "start": cell(15, 15),
+                    "path": [cell(14, 16), cell(13, 17), cell(12, 18)],
+                    "expected_detections": 5.8559
+                },
+                {
+                    "sensor": "c",
+                    "priority": 2,
+                    "start": cell(24, 6),
+                    "path": [cell(23, 5), cell(22, 4), cell(22, 3)],
+                    "expected_detections": 6.3405
+                }
+            ],
+            "expected_detections": 19.0996,
+            "expected_by_step": [4.808, 6.538, 7.7535],
+            "compute_micros": 335
+        })
+    }
+}
