@@ -54,6 +54,28 @@ pub use error::{ApiError, Problem};
 /// written at full precision.
 pub const MAX_BODY_BYTES: usize = 4 * 1024 * 1024;
 
+/// Precomputes a scenario's statistics on a thread pool of its own: the
+/// statistics are computed in parallel, and on the global rayon pool a large
+/// scenario's many tasks would sit ahead of every plan's until it finished.
+/// Here the two share the cores through the OS scheduler instead, so
+/// registering a large scenario does not stall plan traffic.
+pub fn precompute(scenario: crate::scenario::Scenario) -> Planner {
+    static POOL: std::sync::OnceLock<Option<rayon::ThreadPool>> = std::sync::OnceLock::new();
+    let pool = POOL.get_or_init(|| {
+        rayon::ThreadPoolBuilder::new()
+            .thread_name(|i| format!("vigil-precompute-{i}"))
+            .build()
+            .map_err(|e| tracing::warn!(error = %e, "no precompute pool; using the global one"))
+            .ok()
+    });
+    let planner = match pool {
+        Some(pool) => pool.install(|| Planner::new(scenario)),
+        None => Planner::new(scenario),
+    };
+    metrics::histogram!("vigil_precompute_seconds").record(planner.precompute_ms / 1e3);
+    planner
+}
+
 /// The registered scenarios, each with its precomputed [`Planner`].
 #[derive(Debug, Default)]
 pub struct Registry {
@@ -87,7 +109,7 @@ impl Registry {
     pub fn with_store(store: Store, stored: Vec<crate::scenario::Scenario>) -> Self {
         use rayon::prelude::*;
         let mut registry = Self::with_builtins();
-        let planners: Vec<Planner> = stored.into_par_iter().map(Planner::new).collect();
+        let planners: Vec<Planner> = stored.into_par_iter().map(precompute).collect();
         {
             let mut map = registry.write();
             for p in planners {

@@ -124,9 +124,7 @@ pub async fn plan_inline(
                 None => {
                     let cache = state.cache.clone();
                     tokio::task::spawn_blocking(move || {
-                        let planner = Planner::new(scenario);
-                        metrics::histogram!("vigil_precompute_seconds")
-                            .record(planner.precompute_ms / 1e3);
+                        let planner = super::precompute(scenario);
                         cache.insert(Arc::new(planner))
                     })
                     .await?

@@ -173,8 +173,7 @@ pub async fn create(
     // Precompute and store off the async workers; a 2xx means it is on disk.
     let registry = state.registry.clone();
     let (planner, created) = tokio::task::spawn_blocking(move || {
-        let planner = Planner::new(scenario);
-        metrics::histogram!("vigil_precompute_seconds").record(planner.precompute_ms / 1e3);
+        let planner = super::precompute(scenario);
         // A concurrent identical request may have registered it meanwhile;
         // the first one stays.
         registry.insert(Arc::new(planner))

@@ -411,3 +411,39 @@ async fn sigterm_finishes_the_plan_in_flight_then_exits_0() {
     assert!(status.success(), "exit status {status:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Precomputation runs on a pool of its own: five plans sent while a large
+/// scenario (2.25 million cells) is being registered finishes first.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn registering_a_large_scenario_does_not_stall_plans() {
+    let app = crate::helpers::spawn_app().await;
+    let spec = json!({
+        "zone": {"width": 300, "height": 300}, "cell_size": 0.2,
+        "fov": {"shape": "square", "half_width": 30}, "target_speed": 10,
+        "sources": [{"x": -1, "y": 100, "rate": 0.3}, {"x": 301, "y": 200, "rate": 0.3},
+                    {"x": 100, "y": -1, "rate": 0.3}, {"x": 200, "y": 301, "rate": 0.3}]
+    });
+    let (client, url) = (app.client.clone(), app.url("/v1/scenarios"));
+    let register = tokio::spawn(async move {
+        let res = client.post(url).json(&spec).send().await.unwrap();
+        (res.status(), std::time::Instant::now())
+    });
+    let mut planned = std::time::Instant::now();
+    for _ in 0..5 {
+        tokio::time::sleep(Duration::from_millis(100)).await;
+        let plan = app
+            .post_json(
+                "/v1/scenarios/paper-v10/plan",
+                &json!({"sensors": [{"id": 1, "x": 155, "y": 155}, {"id": 2, "x": 35, "y": 35}]}),
+            )
+            .await;
+        planned = std::time::Instant::now();
+        assert_eq!(plan.status(), StatusCode::OK);
+    }
+    let (status, registered) = register.await.unwrap();
+    assert_eq!(status, StatusCode::CREATED);
+    assert!(
+        planned < registered,
+        "the plan waited for the registration to finish"
+    );
+}
