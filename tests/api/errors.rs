@@ -134,7 +134,8 @@ async fn unknown_routes_and_methods_are_problems() {
 #[tokio::test]
 async fn oversized_body_is_413() {
     let app = spawn_app().await;
-    let body = vec![b' '; 9 * 1024 * 1024];
+    // One byte past the 4 MiB limit.
+    let body = vec![b' '; 4 * 1024 * 1024 + 1];
     let res = app
         .post_raw(
             "/v1/scenarios/paper-v10/plan",

@@ -3,7 +3,8 @@
 use reqwest::{Response, StatusCode, header};
 use serde_json::{Value, json};
 use tokio::net::TcpListener;
-use vigil::http::{AppState, router};
+use vigil::http::config::Settings;
+use vigil::http::{AppState, Registry, router};
 
 /// A running server and a client for it.
 pub struct TestApp {
@@ -13,11 +14,21 @@ pub struct TestApp {
     pub client: reqwest::Client,
 }
 
-/// Starts the app on `127.0.0.1:0` in the background of the test's runtime.
+/// Starts the app with default settings on `127.0.0.1:0` in the background
+/// of the test's runtime.
 pub async fn spawn_app() -> TestApp {
+    spawn_with(Settings::default()).await
+}
+
+/// Starts the app with the built-ins and `settings` on `127.0.0.1:0`.
+pub async fn spawn_with(settings: Settings) -> TestApp {
     let listener = TcpListener::bind("127.0.0.1:0").await.unwrap();
     let addr = listener.local_addr().unwrap();
-    let state = tokio::task::spawn_blocking(AppState::new).await.unwrap();
+    let state = tokio::task::spawn_blocking(move || {
+        AppState::with_settings(Registry::with_builtins(), settings)
+    })
+    .await
+    .unwrap();
     tokio::spawn(async move {
         axum::serve(listener, router(state)).await.unwrap();
     });
@@ -139,20 +150,10 @@ pub fn small_spec() -> Value {
     })
 }
 
-/// A valid plan request on `paper-v10`: three sensors, a few targets.
+/// A valid plan request on `paper-v10`: three sensors, a few targets (the
+/// OpenAPI document's example).
 pub fn plan_request() -> Value {
-    json!({
-        "sensors": [
-            {"id": "a", "x": 55.0, "y": 55.0},
-            {"id": 7, "x": 150.0, "y": 150.0},
-            {"id": "c", "x": 245.0, "y": 60.0}
-        ],
-        "targets": [
-            {"id": "t1", "x": 60.0, "y": 40.0, "vx": 10.0, "vy": 0.0},
-            {"x": 140.0, "y": 160.0, "vx": -3.0, "vy": 9.0},
-            {"id": 3, "x": 250.0, "y": 70.0, "vx": 0.0, "vy": -10.0}
-        ]
-    })
+    vigil::http::openapi::examples::plan_request()
 }
 
 /// `a` and `b` agree within `rel` relative error.

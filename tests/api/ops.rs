@@ -8,28 +8,9 @@ use std::time::Duration;
 
 use reqwest::{StatusCode, header};
 use serde_json::{Value, json};
-use tokio::net::TcpListener;
 use vigil::http::config::Settings;
-use vigil::http::{AppState, Registry, router};
 
-use crate::helpers::{TestApp, assert_problem};
-
-async fn spawn_with(settings: Settings) -> TestApp {
-    let listener = TcpListener::bind("127.0.0.1:0").await.unwrap();
-    let addr = listener.local_addr().unwrap();
-    let state = tokio::task::spawn_blocking(move || {
-        AppState::with_settings(Registry::with_builtins(), settings)
-    })
-    .await
-    .unwrap();
-    tokio::spawn(async move {
-        axum::serve(listener, router(state)).await.unwrap();
-    });
-    TestApp {
-        address: format!("http://{addr}"),
-        client: reqwest::Client::new(),
-    }
-}
+use crate::helpers::{assert_problem, spawn_with};
 
 /// A plan request that keeps a core busy for a while: many sensors, a long
 /// horizon, iterated coordination.
@@ -38,20 +19,6 @@ fn slow_plan() -> Value {
         .map(|i| json!({"id": i, "x": 5 + (i % 12) * 25, "y": 5 + (i / 12) * 29}))
         .collect();
     json!({"sensors": sensors, "horizon": 12, "coordination": "iterated"})
-}
-
-#[tokio::test]
-async fn bodies_over_4_mib_are_413() {
-    let app = crate::helpers::spawn_app().await;
-    let body = vec![b' '; 4 * 1024 * 1024 + 16];
-    let res = app
-        .post_raw(
-            "/v1/scenarios/paper-v10/plan",
-            Some("application/json"),
-            body,
-        )
-        .await;
-    assert_problem(res, StatusCode::PAYLOAD_TOO_LARGE, "").await;
 }
 
 #[tokio::test]
