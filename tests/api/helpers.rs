@@ -134,20 +134,10 @@ fn content_type(res: &Response) -> String {
         .unwrap_or_default()
 }
 
-/// A small valid scenario spec: a 100×100 zone of 10-unit cells, one source
-/// west of it.
+/// A small valid scenario spec: a 100×100 zone of 10-unit cells, two
+/// sources (the OpenAPI document's example).
 pub fn small_spec() -> Value {
-    json!({
-        "name": "small",
-        "zone": {"width": 100.0, "height": 100.0},
-        "cell_size": 10.0,
-        "fov": {"shape": "square", "half_width": 15.0},
-        "target_speed": 10.0,
-        "sources": [
-            {"x": -1.0, "y": 50.0, "rate": 0.5},
-            {"x": 50.0, "y": 101.0, "rate": 0.25}
-        ]
-    })
+    vigil::http::openapi::examples::small_spec()
 }
 
 /// A valid plan request on `paper-v10`: three sensors, a few targets (the
