@@ -81,56 +81,73 @@ impl SourceRays {
     }
 }
 
-/// Where the rays of one source crossed the observed regions: per ray, the
-/// intervals seen `s` steps ago, each already pushed by `v·s` (the distance a
-/// target has flown since). Stored compactly, ray by ray.
+/// What the rays of one source saw: per ray, the union of the intervals
+/// seen `s` steps ago, each pushed by `v·s` (the distance a target has flown
+/// since), merged into sorted disjoint intervals. At step `t` the seen set is
+/// the same union pushed a further `v·t`. Stored compactly, ray by ray.
 struct RayHits {
     /// `hits[offsets[m]..offsets[m+1]]` are ray `m`'s intervals.
-    offsets: Vec<usize>,
+    offsets: Vec<u32>,
     hits: Vec<(f64, f64)>,
 }
 
 impl RayHits {
     fn new(sr: &SourceRays, observed: &[Vec<Region>], speed: f64) -> Self {
         let mut buf = Vec::new();
-        let mut tagged: Vec<(usize, (f64, f64))> = Vec::new();
+        let n = sr.dirs.len();
+        // Pass 1: which rays each region meets, to size the ray lists.
+        let mut ranges = Vec::new();
+        let mut counts = vec![0u32; n + 1];
         for (s, regions) in observed.iter().enumerate() {
-            let shift = speed * s as f64;
             for region in regions {
-                let Some((a, b)) = sr.range(region, &mut buf) else {
-                    continue;
-                };
-                for m in a..b {
-                    let (d, inv) = sr.dirs[m];
-                    if let Some((p, q)) = region.ray(sr.source.pos, d, inv) {
-                        tagged.push((m, (p + shift, q + shift)));
+                if let Some((a, b)) = sr.range(region, &mut buf) {
+                    ranges.push((a, b, speed * s as f64, region));
+                    for c in &mut counts[a + 1..=b] {
+                        *c += 1;
                     }
                 }
             }
         }
-        // Counting sort by ray.
-        let mut offsets = vec![0; sr.dirs.len() + 1];
-        for &(m, _) in &tagged {
-            offsets[m + 1] += 1;
+        for m in 0..n {
+            counts[m + 1] += counts[m];
         }
-        for m in 0..sr.dirs.len() {
-            offsets[m + 1] += offsets[m];
+        // Pass 2: every ray's intervals, into its slot.
+        let mut fill = counts.clone();
+        let mut raw = vec![(0.0, 0.0); counts[n] as usize];
+        for &(a, b, shift, region) in &ranges {
+            for m in a..b {
+                let (d, inv) = sr.dirs[m];
+                if let Some((p, q)) = region.ray(sr.source.pos, d, inv) {
+                    raw[fill[m] as usize] = (p + shift, q + shift);
+                    fill[m] += 1;
+                }
+            }
         }
-        let mut next = offsets.clone();
-        let mut hits = vec![(0.0, 0.0); tagged.len()];
-        for (m, h) in tagged {
-            hits[next[m]] = h;
-            next[m] += 1;
+        // Pass 3: sort and merge each ray's intervals.
+        let mut offsets = Vec::with_capacity(n + 1);
+        let mut hits: Vec<(f64, f64)> = Vec::with_capacity(raw.len() / 2);
+        offsets.push(0);
+        for m in 0..n {
+            let list = &mut raw[counts[m] as usize..fill[m] as usize];
+            list.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+            let first = hits.len();
+            for &(p, q) in list.iter() {
+                if hits.len() > first && p <= hits[hits.len() - 1].1 {
+                    let last = hits.len() - 1;
+                    hits[last].1 = hits[last].1.max(q);
+                } else {
+                    hits.push((p, q));
+                }
+            }
+            offsets.push(hits.len() as u32);
         }
         RayHits { offsets, hits }
     }
 
-    /// Ray `m`'s seen intervals at step `t`, pushed a further `lift = v·t`.
+    /// Ray `m`'s seen intervals (sorted, disjoint) as of step 0.
     #[inline]
-    fn lifted(&self, m: usize, lift: f64) -> impl Iterator<Item = (f64, f64)> + '_ {
-        self.hits[self.offsets[m]..self.offsets[m + 1]]
-            .iter()
-            .map(move |&(p, q)| (p + lift, q + lift))
+    fn of(&self, m: usize) -> &[(f64, f64)] {
+        &self.hits[self.offsets[m] as usize..self.offsets[m + 1] as usize]
     }
 }
 
@@ -362,28 +379,26 @@ impl<'a> ExactEstimator<'a> {
             .map(|(sr, seen)| {
                 let mut acc = vec![0.0; na * nb];
                 let mut buf = Vec::new();
-                let mut intervals = Vec::new();
                 let Some((ma, mb)) = sr.range(&region, &mut buf) else {
                     return acc;
                 };
                 for m in ma..mb {
-                    if seen.offsets[m] == seen.offsets[m + 1] {
+                    let hits = seen.of(m);
+                    if hits.is_empty() {
                         continue;
                     }
                     let (d, inv) = sr.dirs[m];
                     let Some((wa, wb)) = region.ray(sr.source.pos, d, inv) else {
                         continue;
                     };
-                    intervals.clear();
-                    intervals.extend(seen.lifted(m, lift).filter(|&(p, q)| q > wa && p < wb));
-                    if intervals.is_empty() {
-                        continue;
-                    }
-                    intervals.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-                    // Walk the union of the seen intervals, clipped to the block.
-                    let mut reach = wa;
-                    for &(p, q) in &intervals {
-                        let (p, q) = (p.max(reach), q.min(wb));
+                    // The seen union at step t, clipped to the block.
+                    let (wa, wb) = (wa - lift, wb - lift);
+                    let from = hits.partition_point(|&(_, q)| q <= wa);
+                    for &(p, q) in &hits[from..] {
+                        if p >= wb {
+                            break;
+                        }
+                        let (p, q) = (p.max(wa) + lift, q.min(wb) + lift);
                         if q > p {
                             walk(
                                 grid,
@@ -396,7 +411,6 @@ impl<'a> ExactEstimator<'a> {
                                 q,
                                 sr.weight,
                             );
-                            reach = q;
                         }
                     }
                 }
@@ -429,7 +443,8 @@ impl<'a> ExactEstimator<'a> {
             };
             let mut sum = 0.0;
             for m in a..b {
-                if excluded.is_empty() && hits.offsets[m] == hits.offsets[m + 1] {
+                let seen = hits.of(m);
+                if excluded.is_empty() && seen.is_empty() {
                     continue;
                 }
                 let (d, inv) = sr.dirs[m];
@@ -437,7 +452,11 @@ impl<'a> ExactEstimator<'a> {
                     continue;
                 };
                 intervals.clear();
-                intervals.extend(hits.lifted(m, lift).filter(|&(p, q)| q > lo && p < hi));
+                intervals.extend(
+                    seen.iter()
+                        .map(|&(p, q)| (p + lift, q + lift))
+                        .filter(|&(p, q)| q > lo && p < hi),
+                );
                 for x in excluded {
                     if let Some(iv) = x.ray(sr.source.pos, d, inv) {
                         intervals.push(iv);
