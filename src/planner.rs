@@ -214,11 +214,11 @@ pub struct PlanInput {
     explain: bool,
 }
 
-fn finite(field: String, v: f64) -> Result<f64, ValidationError> {
+fn finite(field: impl Fn() -> String, v: f64) -> Result<f64, ValidationError> {
     if v.is_finite() {
         Ok(v)
     } else {
-        Err(ValidationError::new(field, "must be a finite number"))
+        Err(ValidationError::new(field(), "must be a finite number"))
     }
 }
 
@@ -250,21 +250,24 @@ impl PlanInput {
                 format!("at most {MAX_HISTORY_STEPS} steps, got {}", history.len()),
             ));
         }
-        let in_zone = |field: String, x: f64, y: f64| -> Result<Cell, ValidationError> {
-            let x = finite(format!("{field}.x"), x)?;
-            let y = finite(format!("{field}.y"), y)?;
-            let p = Point::new(x, y);
-            if !s.in_zone(p) {
-                return Err(ValidationError::new(
-                    field,
-                    format!(
-                        "({x}, {y}) is outside the zone [0,{}]×[0,{}]",
-                        s.width, s.height
-                    ),
-                ));
-            }
-            Ok(s.snap(p))
-        };
+        // Field names are formatted only on error: a history holds thousands
+        // of positions.
+        let in_zone =
+            |field: &dyn Fn() -> String, x: f64, y: f64| -> Result<Cell, ValidationError> {
+                finite(|| format!("{}.x", field()), x)?;
+                finite(|| format!("{}.y", field()), y)?;
+                let p = Point::new(x, y);
+                if !s.in_zone(p) {
+                    return Err(ValidationError::new(
+                        field(),
+                        format!(
+                            "({x}, {y}) is outside the zone [0,{}]×[0,{}]",
+                            s.width, s.height
+                        ),
+                    ));
+                }
+                Ok(s.snap(p))
+            };
         let mut seen = HashSet::new();
         let mut ids = Vec::with_capacity(req.sensors.len());
         let mut starts = Vec::with_capacity(req.sensors.len());
@@ -275,15 +278,17 @@ impl PlanInput {
                     "duplicate sensor id",
                 ));
             }
-            starts.push(in_zone(format!("sensors[{i}]"), sensor.x, sensor.y)?);
+            starts.push(in_zone(&|| format!("sensors[{i}]"), sensor.x, sensor.y)?);
             ids.push(sensor.id.clone());
         }
         let mut targets = Vec::with_capacity(req.targets.len());
         for (i, t) in req.targets.iter().enumerate() {
-            let f = |n: &str| format!("targets[{i}].{n}");
+            for (name, v) in [("x", t.x), ("y", t.y), ("vx", t.vx), ("vy", t.vy)] {
+                finite(|| format!("targets[{i}].{name}"), v)?;
+            }
             targets.push(Target {
-                pos: Point::new(finite(f("x"), t.x)?, finite(f("y"), t.y)?),
-                vel: Point::new(finite(f("vx"), t.vx)?, finite(f("vy"), t.vy)?),
+                pos: Point::new(t.x, t.y),
+                vel: Point::new(t.vx, t.vy),
             });
         }
         let mut past = Vec::with_capacity(history.len());
@@ -300,7 +305,7 @@ impl PlanInput {
             past.push(
                 step.iter()
                     .enumerate()
-                    .map(|(pi, p)| in_zone(format!("history[{si}][{pi}]"), p.x, p.y))
+                    .map(|(pi, p)| in_zone(&|| format!("history[{si}][{pi}]"), p.x, p.y))
                     .collect::<Result<Vec<_>, _>>()?,
             );
         }
@@ -337,8 +342,11 @@ impl Planner {
     pub fn new(scenario: Scenario) -> Self {
         let started = Instant::now();
         let stats = Stats::compute(&scenario);
-        let rays = SourceRays::for_scenario(&scenario);
+        let mut rays = SourceRays::for_scenario(&scenario);
         let grid = ElementaryGrid::new(&scenario);
+        if let Some(grid) = &grid {
+            SourceRays::index_crossings(&mut rays, &scenario, grid);
+        }
         Planner {
             scenario,
             stats,
@@ -362,7 +370,14 @@ impl Planner {
     }
 
     /// Plans a validated request.
+    ///
+    /// Runs on a worker of rayon's global pool (moving there first when
+    /// called from outside it), so the plan's parallel parts split among
+    /// the workers without handing work back and forth between threads.
     pub fn plan(&self, input: &PlanInput) -> PlanResponse {
+        if rayon::current_thread_index().is_none() {
+            return rayon::scope(|_| self.plan(input));
+        }
         let started = Instant::now();
         let s = &self.scenario;
         let est: Box<dyn Estimator + '_> = match input.estimator {
@@ -458,9 +473,9 @@ impl Planner {
     }
 }
 
+/// The cells without repeats, in their order (the estimator reads the
+/// i-th position of each step as one sensor's track).
 fn dedup(cells: &[Cell]) -> Vec<Cell> {
-    let mut v = cells.to_vec();
-    v.sort();
-    v.dedup();
-    v
+    let mut seen = HashSet::with_capacity(cells.len());
+    cells.iter().copied().filter(|c| seen.insert(*c)).collect()
 }

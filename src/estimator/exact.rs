@@ -12,14 +12,23 @@ use crate::scenario::{Cell, FovSpec, Scenario, Source};
 use crate::search::ValueGrid;
 use crate::stats::{Stats, angular_span};
 
-/// Rays per π radians of takeoff angle in the angular grid of each source.
+/// Rays per π radians of takeoff angle in the angular grid of each source,
+/// for scenarios with square fields of view (the fast path).
 ///
-/// The midpoint rule's error on the seen part comes from the kinks of the
-/// integrand (corners of the fields of view). Measured on `paper-v10` with
-/// history, against 4096 rays per π: 256 → max 2.3e-3, mean 6.5e-4 targets;
-/// 384 → max 1.4e-3, mean 2.9e-4; 512 → max 1.0e-3, mean 2.0e-4. The cost is
-/// linear in this number; 384 keeps the error two orders of magnitude under
-/// the statistical error of any realistic check.
+/// The midpoint rule's error comes from the kinks of the integrand (corners
+/// of the fields of view); the cost of a plan is about linear in this number.
+/// Measured on the reference workload (`paper-v10`, 10 sensors, 16 steps of
+/// history, every cell a sensor can reach at T = 3) against 4096 rays per π,
+/// with values averaging 1.80 targets (`cargo run --release -p vigil-loadtest
+/// --example accuracy`): 96 → max 1.7e-2, mean 3.6e-3; 128 → max 1.2e-2,
+/// mean 2.2e-3 (0.12 %); 192 → 5.7e-3, 1.1e-3; 384 → 1.7e-3, 3.0e-4.
+/// 128 keeps the error under the statistical error of any realistic check
+/// (`tests/model.rs` checks against Monte Carlo) at a third of the cost of 384.
+pub const RAYS_PER_PI_SQUARE: f64 = 128.0;
+
+/// Rays per π for other fields of view (circles), which the general path
+/// evaluates: there the excluded areas of coordination are integrated by
+/// the same rule, whose error next to a source is several times larger.
 pub const RAYS_PER_PI: f64 = 384.0;
 
 /// The fixed angular grid of one source: midpoints of `n` equal steps over
@@ -33,11 +42,52 @@ pub struct SourceRays {
     dirs: Vec<(Point, Point)>,
     /// `λ_j/(π v)·step`: targets per unit of ray length, per ray.
     weight: f64,
+    /// Where each ray crosses the elementary grid, when indexed.
+    crossings: Option<Crossings>,
+}
+
+/// The elementary rectangles each ray of a source crosses on its way
+/// through the zone, in order: ray `m` enters `cells[k]` at distance `r[k]`
+/// from the source, for `k` in `offsets[m]..offsets[m+1]`, and leaves the
+/// last one at the ray's next `r` (each ray's `r` has one entry more than
+/// its cells, so ray `m`'s distances start at `offsets[m] + m`). With it a
+/// seen interval is spread over rectangles by a merge of two sorted lists
+/// instead of a grid walk, at every step of every request.
+#[derive(Debug, Clone)]
+struct Crossings {
+    offsets: Vec<u32>,
+    r: Vec<f64>,
+    cells: Vec<[u32; 2]>,
+    /// `cells[k]` as an index into the whole grid, `b·nx + a`.
+    lin: Vec<u32>,
+}
+
+impl Crossings {
+    /// Ray `m`'s entry distances (and final exit) and rectangles.
+    #[inline]
+    fn of(&self, m: usize) -> (&[f64], &[[u32; 2]], &[u32]) {
+        let (a, b) = (self.offsets[m] as usize, self.offsets[m + 1] as usize);
+        (
+            &self.r[a + m..b + m + 1],
+            &self.cells[a..b],
+            &self.lin[a..b],
+        )
+    }
 }
 
 impl SourceRays {
-    /// The grids of every source of a scenario with a non-zero rate.
+    /// The grids of every source of a scenario with a non-zero rate, at
+    /// [`RAYS_PER_PI_SQUARE`] or [`RAYS_PER_PI`] by its field of view.
     pub fn for_scenario(s: &Scenario) -> Vec<SourceRays> {
+        let density = match s.fov {
+            FovSpec::Square { .. } => RAYS_PER_PI_SQUARE,
+            FovSpec::Circle { .. } => RAYS_PER_PI,
+        };
+        Self::with_density(s, density)
+    }
+
+    /// The same at `rays_per_pi` rays per π radians (for accuracy studies).
+    pub fn with_density(s: &Scenario, rays_per_pi: f64) -> Vec<SourceRays> {
         let zone = s.zone_region();
         let mut buf = Vec::new();
         s.sources
@@ -45,13 +95,17 @@ impl SourceRays {
             .filter(|src| src.rate > 0.0)
             .filter_map(|src| {
                 let (lo, hi) = angular_span(src, &zone, &mut buf)?;
-                let n = (((hi - lo) / std::f64::consts::PI) * RAYS_PER_PI)
+                let n = (((hi - lo) / std::f64::consts::PI) * rays_per_pi)
                     .ceil()
                     .max(1.0) as usize;
                 let step = (hi - lo) / n as f64;
+                // No component exactly 0, so slab intersections need no
+                // special case (a tilt of 1e-12 rad changes nothing).
+                let nudge = |c: f64| if c == 0.0 { 1e-12 } else { c };
                 let dirs = (0..n)
                     .map(|m| {
                         let d = src.direction(lo + (m as f64 + 0.5) * step);
+                        let d = Point::new(nudge(d.x), nudge(d.y));
                         (d, Point::new(1.0 / d.x, 1.0 / d.y))
                     })
                     .collect();
@@ -61,24 +115,118 @@ impl SourceRays {
                     step,
                     dirs,
                     weight: src.rate / (std::f64::consts::PI * s.speed) * step,
+                    crossings: None,
                 })
             })
             .collect()
     }
 
+    /// Indexes where every ray crosses `grid`'s rectangles (see
+    /// [`ExactEstimator`]), unless that would take more than about 100 bytes
+    /// per lattice cell; without the index, plans walk the grid instead
+    /// (the same values, more slowly).
+    pub fn index_crossings(rays: &mut [SourceRays], s: &Scenario, grid: &ElementaryGrid) {
+        let (nx, ny) = grid.dims();
+        let bound: usize = rays.iter().map(|sr| sr.dirs.len() * (nx + ny)).sum();
+        if bound > (5 * s.cell_count()).max(1 << 20) || nx * ny > u32::MAX as usize {
+            return;
+        }
+        let zone = s.zone_region();
+        rays.par_iter_mut().for_each(|sr| {
+            let n = sr.dirs.len();
+            let mut offsets = Vec::with_capacity(n + 1);
+            let mut r = Vec::new();
+            let mut cells = Vec::new();
+            let mut lin = Vec::new();
+            offsets.push(0);
+            for &(d, inv) in &sr.dirs {
+                if let Some((r0, r1)) = zone.ray(sr.source.pos, d, inv) {
+                    trace(
+                        grid,
+                        (0, nx, 0, ny),
+                        sr.source.pos,
+                        d,
+                        inv,
+                        r0,
+                        r1,
+                        |a, b, from, _| {
+                            r.push(from);
+                            cells.push([a as u32, b as u32]);
+                            lin.push((b * nx + a) as u32);
+                        },
+                    );
+                    r.push(r1);
+                } else {
+                    r.push(0.0);
+                }
+                offsets.push(cells.len() as u32);
+            }
+            sr.crossings = Some(Crossings {
+                offsets,
+                r,
+                cells,
+                lin,
+            });
+        });
+    }
+
     /// Approximate heap memory held, bytes.
     pub fn memory_bytes(&self) -> usize {
         std::mem::size_of::<(Point, Point)>() * self.dirs.len()
+            + self.crossings.as_ref().map_or(0, |c| {
+                4 * c.offsets.len() + 8 * c.r.len() + 8 * c.cells.len()
+            })
     }
 
-    /// Ray indices whose directions can meet `region`.
+    /// Ray indices whose directions can meet `region` (a superset: callers
+    /// intersect each ray with the region anyway).
     fn range(&self, region: &Region, buf: &mut Vec<Point>) -> Option<(usize, usize)> {
-        let (lo, hi) = angular_span(&self.source, region, buf)?;
+        let (lo, hi, margin) = if region.disk.is_none() {
+            // The corners' angles, to within 5e-4 rad, then that and one ray
+            // more on each side: cheaper than atan2 for the many squares of
+            // a history.
+            let h = self.source.heading.unit();
+            let o = self.source.pos;
+            let r = &region.rect;
+            let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+            for (x, y) in [(r.x0, r.y0), (r.x1, r.y0), (r.x1, r.y1), (r.x0, r.y1)] {
+                let (dx, dy) = (x - o.x, y - o.y);
+                let a = approx_atan2(h.x * dy - h.y * dx, h.x * dx + h.y * dy);
+                lo = lo.min(a);
+                hi = hi.max(a);
+            }
+            (lo, hi, 1.0 + 5e-4 / self.step)
+        } else {
+            let (lo, hi) = angular_span(&self.source, region, buf)?;
+            (lo, hi, 0.0)
+        };
         let n = self.dirs.len();
-        let a = (((lo - self.lo) / self.step).floor().max(0.0) as usize).min(n);
-        let b = (((hi - self.lo) / self.step).ceil().max(0.0) as usize).min(n);
+        let a = (((lo - self.lo) / self.step - margin).floor().max(0.0) as usize).min(n);
+        let b = (((hi - self.lo) / self.step + margin).ceil().max(0.0) as usize).min(n);
         (a < b).then_some((a, b))
     }
+}
+
+/// `atan2(y, x)` to within 5e-4 rad (measured: 2.1e-4): a degree-7 odd
+/// polynomial for the arctangent on [0, 1], and the octant symmetries.
+#[inline]
+fn approx_atan2(y: f64, x: f64) -> f64 {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    let (ax, ay) = (x.abs(), y.abs());
+    let (lo, hi) = if ax < ay { (ax, ay) } else { (ay, ax) };
+    if hi == 0.0 {
+        return 0.0;
+    }
+    let a = lo / hi;
+    let s = a * a;
+    let mut r = (((-0.046_496_474_9 * s + 0.159_314_22) * s - 0.327_622_764) * s) * a + a;
+    if ay > ax {
+        r = FRAC_PI_2 - r;
+    }
+    if x < 0.0 {
+        r = PI - r;
+    }
+    if y < 0.0 { -r } else { r }
 }
 
 /// What the rays of one source saw: per ray, the union of the intervals
@@ -95,11 +243,19 @@ impl RayHits {
     fn new(sr: &SourceRays, observed: &[Vec<Region>], speed: f64) -> Self {
         let mut buf = Vec::new();
         let n = sr.dirs.len();
+        let o = sr.source.pos;
         // Pass 1: which rays each region meets, to size the ray lists.
+        // Regions go track by track (the i-th region of every step in turn):
+        // one sensor's consecutive fields of view overlap on most rays, so
+        // pass 2 merges them as they come and leaves little to sort.
+        let tracks = observed.iter().map(Vec::len).max().unwrap_or(0);
         let mut ranges = Vec::new();
         let mut counts = vec![0u32; n + 1];
-        for (s, regions) in observed.iter().enumerate() {
-            for region in regions {
+        for i in 0..tracks {
+            for (s, regions) in observed.iter().enumerate() {
+                let Some(region) = regions.get(i) else {
+                    continue;
+                };
                 if let Some((a, b)) = sr.range(region, &mut buf) {
                     ranges.push((a, b, speed * s as f64, region));
                     for c in &mut counts[a + 1..=b] {
@@ -111,15 +267,42 @@ impl RayHits {
         for m in 0..n {
             counts[m + 1] += counts[m];
         }
-        // Pass 2: every ray's intervals, into its slot.
+        // Pass 2: every ray's intervals, into its slot, merged with the
+        // slot's last interval when they overlap.
         let mut fill = counts.clone();
         let mut raw = vec![(0.0, 0.0); counts[n] as usize];
+        let mut push = |m: usize, p: f64, q: f64| {
+            let (first, end) = (counts[m] as usize, fill[m] as usize);
+            if end > first {
+                let last = &mut raw[end - 1];
+                if p <= last.1 && q >= last.0 {
+                    *last = (last.0.min(p), last.1.max(q));
+                    return;
+                }
+            }
+            raw[end] = (p, q);
+            fill[m] += 1;
+        };
         for &(a, b, shift, region) in &ranges {
-            for m in a..b {
-                let (d, inv) = sr.dirs[m];
-                if let Some((p, q)) = region.ray(sr.source.pos, d, inv) {
-                    raw[fill[m] as usize] = (p + shift, q + shift);
-                    fill[m] += 1;
+            if region.disk.is_none() {
+                // Slab test, branch-free (no direction component is 0).
+                let r = &region.rect;
+                let (x0, x1, y0, y1) = (r.x0 - o.x, r.x1 - o.x, r.y0 - o.y, r.y1 - o.y);
+                for (m, &(_, inv)) in sr.dirs[a..b].iter().enumerate() {
+                    let (tx0, tx1) = (x0 * inv.x, x1 * inv.x);
+                    let (ty0, ty1) = (y0 * inv.y, y1 * inv.y);
+                    let p = tx0.min(tx1).max(ty0.min(ty1)).max(0.0);
+                    let q = tx0.max(tx1).min(ty0.max(ty1));
+                    if p <= q {
+                        push(a + m, p + shift, q + shift);
+                    }
+                }
+            } else {
+                for m in a..b {
+                    let (d, inv) = sr.dirs[m];
+                    if let Some((p, q)) = region.ray(o, d, inv) {
+                        push(m, p + shift, q + shift);
+                    }
                 }
             }
         }
@@ -209,7 +392,15 @@ impl StepWindows {
             )
         });
         let total: usize = reach.iter().map(size).sum();
-        if !reach.is_empty() && size(&bbox) <= (1 << 16).max(2 * total) {
+        let (nx, ny) = grid.dims();
+        if nx * ny <= 1 << 16 {
+            // A small grid: one window over all of it (the fastest to fill).
+            Self {
+                blocks: vec![(0, nx, 0, ny)],
+                built: vec![OnceLock::new()],
+                slot: vec![0; reach.len()],
+            }
+        } else if !reach.is_empty() && size(&bbox) <= (1 << 16).max(2 * total) {
             Self {
                 blocks: vec![bbox],
                 built: vec![OnceLock::new()],
@@ -371,6 +562,10 @@ impl<'a> ExactEstimator<'a> {
         let region = Region { rect, disk: None };
         let lift = s.speed * t as f64;
         let block = (a0, a1, b0, b1);
+        let whole = {
+            let (nx, ny) = grid.dims();
+            block == (0, nx, 0, ny)
+        };
         // Each source accumulates into its own buffer, in parallel.
         let seen_by_source: Vec<Vec<f64>> = self
             .rays
@@ -399,27 +594,41 @@ impl<'a> ExactEstimator<'a> {
                             break;
                         }
                         let (p, q) = (p.max(wa) + lift, q.min(wb) + lift);
-                        if q > p {
-                            walk(
-                                grid,
-                                block,
-                                &mut acc,
-                                sr.source.pos,
-                                d,
-                                inv,
-                                p,
-                                q,
-                                sr.weight,
-                            );
+                        if q <= p {
+                            continue;
+                        }
+                        if let Some(cr) = &sr.crossings {
+                            let (rs, cells, lin) = cr.of(m);
+                            let mut k = rs.partition_point(|&x| x <= p).saturating_sub(1);
+                            if whole {
+                                // The block is the grid: no bounds to check.
+                                while k < lin.len() && rs[k] < q {
+                                    acc[lin[k] as usize] += rs[k + 1].min(q) - rs[k].max(p);
+                                    k += 1;
+                                }
+                                continue;
+                            }
+                            while k < cells.len() && rs[k] < q {
+                                let len = rs[k + 1].min(q) - rs[k].max(p);
+                                let [a, b] = cells[k];
+                                let (a, b) = (a as usize, b as usize);
+                                // Rounding at the block's edge: a sliver outside is dropped.
+                                if len > 0.0 && (a0..a1).contains(&a) && (b0..b1).contains(&b) {
+                                    acc[(b - b0) * na + (a - a0)] += len;
+                                }
+                                k += 1;
+                            }
+                        } else {
+                            walk(grid, block, &mut acc, sr.source.pos, d, inv, p, q);
                         }
                     }
                 }
                 acc
             })
             .collect();
-        for acc in &seen_by_source {
+        for (acc, sr) in seen_by_source.iter().zip(self.rays) {
             for (u, s) in unseen.iter_mut().zip(acc) {
-                *u += s;
+                *u -= sr.weight * s;
             }
         }
         Window {
@@ -526,10 +735,8 @@ impl<'a> ExactEstimator<'a> {
     }
 }
 
-/// Subtracts `weight·length` of the ray segment `[r0, r1]` from `acc`, the
-/// unseen mass of the elementary rectangles of `block`, rectangle by
-/// rectangle (a 2-D DDA over the breakpoints). The segment lies inside the
-/// block; rounding at its edge is clamped.
+/// Adds to `acc`, the seen length in each elementary rectangle of `block`,
+/// the ray segment `[r0, r1]`, rectangle by rectangle.
 #[allow(clippy::too_many_arguments)]
 fn walk(
     grid: &ElementaryGrid,
@@ -540,15 +747,33 @@ fn walk(
     inv: Point,
     r0: f64,
     r1: f64,
-    weight: f64,
+) {
+    let (a_lo, b_lo, na) = (block.0, block.2, block.1 - block.0);
+    trace(grid, block, o, d, inv, r0, r1, |a, b, from, to| {
+        acc[(b - b_lo) * na + (a - a_lo)] += to - from;
+    });
+}
+
+/// Calls `f(a, b, from, to)` for each elementary rectangle `(a, b)` of
+/// `block` the ray segment `[r0, r1]` crosses, in order, with the part of
+/// the segment inside it: a 2-D DDA over the breakpoints. The segment lies
+/// inside the block; rounding at its edge is clamped.
+#[allow(clippy::too_many_arguments)]
+fn trace(
+    grid: &ElementaryGrid,
+    block: Block,
+    o: Point,
+    d: Point,
+    inv: Point,
+    r0: f64,
+    r1: f64,
+    mut f: impl FnMut(usize, usize, f64, f64),
 ) {
     let (xs, ys) = (&grid.xs, &grid.ys);
     let (a_lo, a_hi, b_lo, b_hi) = (block.0, block.1 - 1, block.2, block.3 - 1);
-    let na = block.1 - block.0;
     let start = Point::new(o.x + d.x * r0, o.y + d.y * r0);
     let mut a = grid.locate_x(start.x, d.x).clamp(a_lo, a_hi);
     let mut b = grid.locate_y(start.y, d.y).clamp(b_lo, b_hi);
-    let mut idx = (b - b_lo) * na + (a - a_lo);
     // Distance to the next boundary on each axis (infinite along an axis
     // the ray runs parallel to).
     let forward_x = d.x >= 0.0;
@@ -574,7 +799,7 @@ fn walk(
         let boundary = if step_x { tx } else { ty };
         let end = if boundary < r1 { boundary } else { r1 };
         if end > r {
-            acc[idx] -= weight * (end - r);
+            f(a, b, r, end);
             r = end;
         }
         if boundary >= r1 {
@@ -586,10 +811,8 @@ fn walk(
             }
             if forward_x {
                 a += 1;
-                idx += 1;
             } else {
                 a -= 1;
-                idx -= 1;
             }
             tx = next_x(a);
         } else {
@@ -598,10 +821,8 @@ fn walk(
             }
             if forward_y {
                 b += 1;
-                idx += na;
             } else {
                 b -= 1;
-                idx -= na;
             }
             ty = next_y(b);
         }
@@ -665,5 +886,24 @@ impl Estimator for ExactEstimator<'_> {
 
     fn order_independent(&self) -> bool {
         true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::approx_atan2;
+
+    #[test]
+    fn approx_atan2_is_within_its_bound() {
+        let mut worst = 0.0f64;
+        for i in 0..20_000 {
+            let angle = -std::f64::consts::PI + i as f64 * (std::f64::consts::TAU / 20_000.0);
+            for r in [1e-3, 1.0, 1e4] {
+                let (y, x) = (r * angle.sin(), r * angle.cos());
+                worst = worst.max((approx_atan2(y, x) - y.atan2(x)).abs());
+            }
+        }
+        assert!(worst < 5e-4, "worst error {worst}");
+        assert_eq!(approx_atan2(0.0, 0.0), 0.0);
     }
 }

@@ -15,7 +15,7 @@ mod exact;
 mod paper;
 
 pub use elementary::ElementaryGrid;
-pub use exact::{ExactEstimator, RAYS_PER_PI, SourceRays};
+pub use exact::{ExactEstimator, RAYS_PER_PI, RAYS_PER_PI_SQUARE, SourceRays};
 pub use paper::PaperEstimator;
 
 use crate::geometry::{Point, Region};
