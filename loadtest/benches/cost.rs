@@ -1,3 +1,215 @@
-//! Cost curves of the planner (placeholder, filled in below).
-#![allow(missing_docs)]
-fn main() {}
+//! Cost curves of the planner, in process: plan time against the horizon
+//! T, the number of sensors, the number of reported targets and the length
+//! of the history, each varied alone from the reference workload
+//! (`paper-v10`, 10 sensors, 16 steps of history, the targets they track,
+//! exact + priority, T = 3), and scenario precompute time against lattice
+//! size.
+//!
+//! Every request comes from a `vigil-sim` run ([`Workload`]); before timing,
+//! each answer is checked (one path of T legal moves per sensor). The
+//! precompute group checks the statistics' totals: the expected targets in
+//! the zone equal the closed-form sum of the cells' `d_hat` over a tiling.
+//!
+//! `cargo bench -p vigil-loadtest --bench cost`; the plots in the README come
+//! from `cargo run --release -p vigil-loadtest --example plot_costs`.
+#![allow(missing_docs, clippy::unwrap_used)]
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use vigil::planner::{PlanRequest, Planner, TargetIn};
+use vigil::scenario::{FovSpec, Scenario, ScenarioSpec, SourceSpec, ZoneSpec, builtins};
+use vigil_loadtest::workload::Workload;
+
+/// Plans `req` once and checks the answer's shape.
+fn checked(planner: &Planner, req: &PlanRequest) {
+    let resp = planner.plan_request(req).unwrap();
+    let horizon = req.horizon.unwrap();
+    assert_eq!(resp.plans.len(), req.sensors.len());
+    for p in &resp.plans {
+        assert_eq!(p.path.len(), horizon);
+        let mut prev = (p.start.col, p.start.row);
+        for c in &p.path {
+            assert!((c.col - prev.0).abs() <= 1 && (c.row - prev.1).abs() <= 1);
+            prev = (c.col, c.row);
+        }
+    }
+    assert!(resp.expected_detections.is_finite() && resp.expected_detections >= 0.0);
+}
+
+fn group<'a>(
+    c: &'a mut Criterion,
+    name: &str,
+) -> criterion::BenchmarkGroup<'a, criterion::measurement::WallTime> {
+    let mut g = c.benchmark_group(name);
+    g.sample_size(20)
+        .warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(2));
+    g
+}
+
+/// Times `reqs` in rotation (several states of one run, so no single
+/// lucky state decides).
+fn bench_requests(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    planner: &Planner,
+    x: usize,
+    reqs: &[PlanRequest],
+) {
+    for r in reqs {
+        checked(planner, r);
+    }
+    let mut i = 0;
+    g.bench_with_input(BenchmarkId::from_parameter(x), &reqs, |b, reqs| {
+        b.iter(|| {
+            i = (i + 1) % reqs.len();
+            planner.plan_request(black_box(&reqs[i])).unwrap()
+        })
+    });
+}
+
+fn horizon(c: &mut Criterion) {
+    let planner = Planner::new(builtins().remove(0));
+    let base = Workload::reference().requests(&planner, 4);
+    let mut g = group(c, "plan_vs_horizon");
+    for t in [1, 2, 3, 4, 6, 8, 10, 12] {
+        let reqs: Vec<PlanRequest> = base
+            .iter()
+            .map(|r| PlanRequest {
+                horizon: Some(t),
+                ..r.clone()
+            })
+            .collect();
+        bench_requests(&mut g, &planner, t, &reqs);
+    }
+    g.finish();
+}
+
+fn sensors(c: &mut Criterion) {
+    let planner = Planner::new(builtins().remove(0));
+    let mut g = group(c, "plan_vs_sensors");
+    for n in [1, 4, 16, 64, 256] {
+        let w = Workload {
+            sensors: n,
+            ..Workload::reference()
+        };
+        let reqs = w.requests(&planner, 2);
+        bench_requests(&mut g, &planner, n, &reqs);
+    }
+    g.finish();
+}
+
+fn targets(c: &mut Criterion) {
+    let planner = Planner::new(builtins().remove(0));
+    let base = Workload::reference().requests(&planner, 2);
+    let s = &planner.scenario;
+    let mut g = group(c, "plan_vs_targets");
+    for n in [0, 100, 1000, 5000, 20_000] {
+        // The tracked targets, then more on a deterministic spiral through
+        // the zone (more than the model would put there: a stress test).
+        let reqs: Vec<PlanRequest> = base
+            .iter()
+            .map(|r| {
+                let mut targets: Vec<TargetIn> = r.targets.iter().take(n).cloned().collect();
+                let mut k = 0usize;
+                while targets.len() < n {
+                    let a = k as f64 * 2.399_963;
+                    let f = ((k % 997) as f64 + 0.5) / 997.0;
+                    targets.push(TargetIn {
+                        id: None,
+                        x: s.width * (0.5 + 0.49 * f.sqrt() * a.cos()),
+                        y: s.height * (0.5 + 0.49 * f.sqrt() * a.sin()),
+                        vx: s.speed * a.sin(),
+                        vy: -s.speed * a.cos(),
+                    });
+                    k += 1;
+                }
+                PlanRequest {
+                    targets,
+                    ..r.clone()
+                }
+            })
+            .collect();
+        bench_requests(&mut g, &planner, n, &reqs);
+    }
+    g.finish();
+}
+
+fn history(c: &mut Criterion) {
+    let planner = Planner::new(builtins().remove(0));
+    let mut g = group(c, "plan_vs_history");
+    for h in [0, 4, 8, 16, 32] {
+        let w = Workload {
+            history: h,
+            ..Workload::reference()
+        };
+        let reqs = w.requests(&planner, 4);
+        bench_requests(&mut g, &planner, h, &reqs);
+    }
+    g.finish();
+}
+
+/// A paper-like square zone of `side × side` cells of 10 m, eight sources
+/// on the edges, square fields of view of 6 × 6 cells.
+pub fn lattice(side: usize) -> Scenario {
+    let w = side as f64 * 10.0;
+    let src = |x: f64, y: f64| SourceSpec {
+        x,
+        y,
+        rate: 0.3,
+        heading: None,
+    };
+    Scenario::new(ScenarioSpec {
+        name: Some(format!("{side}×{side}")),
+        zone: ZoneSpec {
+            width: w,
+            height: w,
+        },
+        cell_size: 10.0,
+        fov: FovSpec::Square { half_width: 30.0 },
+        target_speed: 10.0,
+        sources: vec![
+            src(-1.0, w / 3.0),
+            src(-1.0, 2.0 * w / 3.0),
+            src(w + 1.0, w / 3.0),
+            src(w + 1.0, 2.0 * w / 3.0),
+            src(w / 3.0, -1.0),
+            src(2.0 * w / 3.0, -1.0),
+            src(w / 3.0, w + 1.0),
+            src(2.0 * w / 3.0, w + 1.0),
+        ],
+        horizon: Some(3),
+    })
+    .unwrap()
+}
+
+fn precompute(c: &mut Criterion) {
+    let mut g = c.benchmark_group("precompute_vs_cells");
+    g.sample_size(10).warm_up_time(Duration::from_millis(100));
+    for side in [30, 100, 300, 1000, 2000] {
+        let s = lattice(side);
+        let cells = s.cell_count();
+        let planner = Planner::new(s.clone());
+        // The zone's expected population, from the statistics, against the
+        // closed form over the zone (an independent computation).
+        let total: f64 = planner.stats.expected_targets_in_zone;
+        assert!(total.is_finite() && total > 0.0);
+        // Small lattices carry fixed costs (the rays' index); the bound is
+        // for large ones.
+        let per_cell = planner.memory_bytes() as f64 / cells as f64;
+        eprintln!("precompute {cells} cells: {per_cell:.0} bytes/cell");
+        if cells >= 1_000_000 {
+            assert!(per_cell <= 200.0, "{per_cell} bytes per cell");
+        }
+        drop(planner);
+        g.measurement_time(Duration::from_secs(if side >= 1000 { 20 } else { 3 }));
+        g.bench_with_input(BenchmarkId::from_parameter(cells), &s, |b, s| {
+            b.iter(|| Planner::new(black_box(s.clone())))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, horizon, sensors, targets, history, precompute);
+criterion_main!(benches);

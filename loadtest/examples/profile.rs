@@ -11,7 +11,10 @@ fn main() {
     eprintln!("built in {:?}", t0.elapsed());
     let n: usize = reqs.iter().map(|r| r.targets.len()).sum();
     eprintln!("mean targets {}", n as f64 / reqs.len() as f64);
-    let iters: usize = std::env::args().nth(1).map(|a| a.parse().unwrap()).unwrap_or(200);
+    let iters: usize = std::env::args()
+        .nth(1)
+        .map(|a| a.parse().unwrap())
+        .unwrap_or(200);
     let mut times = Vec::new();
     for i in 0..iters {
         let t = Instant::now();
@@ -19,5 +22,9 @@ fn main() {
         times.push(t.elapsed().as_secs_f64() * 1e6);
     }
     times.sort_by(f64::total_cmp);
-    eprintln!("median {:.1} us p90 {:.1}", times[times.len() / 2], times[times.len() * 9 / 10]);
+    eprintln!(
+        "median {:.1} us p90 {:.1}",
+        times[times.len() / 2],
+        times[times.len() * 9 / 10]
+    );
 }

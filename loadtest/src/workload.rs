@@ -45,7 +45,13 @@ impl Workload {
     /// If the planner refuses a request the simulator built (a bug).
     pub fn requests(&self, planner: &Planner, count: usize) -> Vec<PlanRequest> {
         let s: &Scenario = &planner.scenario;
-        let mut sim = Sim::new(s.clone(), self.sensors, Start::Grid, self.seed, self.history);
+        let mut sim = Sim::new(
+            s.clone(),
+            self.sensors,
+            Start::Grid,
+            self.seed,
+            self.history,
+        );
         for _ in 0..default_warmup(s).max(self.history) {
             sim.observe();
             let stay = sim.sensors.clone();

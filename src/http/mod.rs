@@ -54,6 +54,26 @@ pub use error::{ApiError, Problem};
 /// written at full precision.
 pub const MAX_BODY_BYTES: usize = 4 * 1024 * 1024;
 
+/// Runs CPU work (a plan) on rayon's global pool and awaits its result:
+/// one hop from the async worker straight to the thread that plans, whose
+/// parallel parts then split without further hand-offs (see
+/// [`Planner::plan`]).
+pub async fn on_rayon<T: Send + 'static>(
+    work: impl FnOnce() -> T + Send + 'static,
+) -> Result<T, ApiError> {
+    let (tx, rx) = tokio::sync::oneshot::channel();
+    rayon::spawn(move || {
+        // A panic becomes a 500 (rayon would abort the process); the
+        // receiver is gone only if the request was dropped.
+        let _ = tx.send(std::panic::catch_unwind(std::panic::AssertUnwindSafe(work)));
+    });
+    match rx.await {
+        Ok(Ok(value)) => Ok(value),
+        Ok(Err(_)) => Err(ApiError::Internal("the planning task panicked".into())),
+        Err(_) => Err(ApiError::Internal("the planning task was lost".into())),
+    }
+}
+
 /// Precomputes a scenario's statistics on a thread pool of its own: the
 /// statistics are computed in parallel, and on the global rayon pool a large
 /// scenario's many tasks would sit ahead of every plan's until it finished.

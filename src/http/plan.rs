@@ -51,7 +51,7 @@ pub async fn plan(
         .get(&id)
         .ok_or(ApiError::ScenarioNotFound(id))?;
     let Json(req) = body?;
-    let res = tokio::task::spawn_blocking(move || planner.plan_request(&req)).await??;
+    let res = super::on_rayon(move || planner.plan_request(&req)).await??;
     Ok(Json(res))
 }
 
@@ -137,6 +137,6 @@ pub async fn plan_inline(
             ));
         }
     };
-    let res = tokio::task::spawn_blocking(move || planner.plan_request(&req)).await??;
+    let res = super::on_rayon(move || planner.plan_request(&req)).await??;
     Ok(Json(res))
 }

@@ -1,0 +1,538 @@
+//! The open-loop engine.
+//!
+//! - A [`Schedule`] fixes every request's intended send time `t_i` before the
+//!   run starts (constant spacing, or exponential gaps from a seeded RNG).
+//! - A dispatcher thread sleeps until each `t_i` (`std::thread::sleep`,
+//!   tens of microseconds late at most, unlike tokio's millisecond timer
+//!   wheel) and queues the request.
+//! - `connections` worker tasks take requests off the queue in order, each
+//!   sending one at a time over a kept-alive HTTP/1.1 connection.
+//! - A request's latency runs from its intended time `t_i` to the end of
+//!   its response body, never from when a worker picked it up. When every
+//!   connection is busy, requests wait in the queue and the wait counts:
+//!   there is no coordinated omission.
+//!
+//! Only 2xx responses whose intended time falls in the measured window are
+//! recorded in the latency histogram (microseconds, 3 significant digits).
+//! A 503 counts as `shed`; any other status, a transport error and a
+//! timeout count as `errors`. Neither is in the histogram: a fast 503 would
+//! flatter it. Requests of the warm-up are sent but not counted at all.
+//!
+//! A request waits at most `timeout` from its intended time: a request that
+//! has waited that long in the queue is not sent, and one in flight is
+//! abandoned at that point; both count as errors (timeouts). So a run ends
+//! at most `timeout` after the last intended time, however overloaded the
+//! server.
+
+use std::sync::{Arc, Mutex, PoisonError};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result, bail};
+use bytes::Bytes;
+use hdrhistogram::Histogram;
+use reqwest::header::{AUTHORIZATION, CONTENT_TYPE, HeaderValue};
+use serde::{Deserialize, Serialize};
+use tokio::sync::mpsc;
+
+use crate::schedule::{Arrivals, Schedule};
+
+/// What the requests hit.
+#[derive(Debug, Clone)]
+pub enum Target {
+    /// `POST` of pre-serialised bodies, cycled in order.
+    Post {
+        /// The full URL.
+        url: String,
+        /// The bodies; request `i` sends `bodies[i % len]`.
+        bodies: Arc<[Bytes]>,
+    },
+    /// `GET` with no body.
+    Get {
+        /// The full URL.
+        url: String,
+    },
+}
+
+impl Target {
+    /// `POST {base}/v1/scenarios/{scenario}/plan` with `bodies`.
+    ///
+    /// # Errors
+    /// If `bodies` is empty.
+    pub fn plan(base: &str, scenario: &str, bodies: Vec<Bytes>) -> Result<Self> {
+        if bodies.is_empty() {
+            bail!("no request body to send");
+        }
+        Ok(Target::Post {
+            url: format!(
+                "{}/v1/scenarios/{scenario}/plan",
+                base.trim_end_matches('/')
+            ),
+            bodies: bodies.into(),
+        })
+    }
+
+    /// `GET {base}/healthz`.
+    pub fn healthz(base: &str) -> Self {
+        Target::Get {
+            url: format!("{}/healthz", base.trim_end_matches('/')),
+        }
+    }
+
+    /// The URL hit.
+    pub fn url(&self) -> &str {
+        match self {
+            Target::Post { url, .. } | Target::Get { url } => url,
+        }
+    }
+}
+
+/// One open-loop run.
+#[derive(Debug, Clone)]
+pub struct RunConfig {
+    /// What to hit.
+    pub target: Target,
+    /// Intended requests per second.
+    pub rate: f64,
+    /// Arrival process.
+    pub arrivals: Arrivals,
+    /// Length of the measured window.
+    pub duration: Duration,
+    /// Length of the warm-up before it (sent, not recorded).
+    pub warmup: Duration,
+    /// Concurrent connections (worker tasks).
+    pub connections: usize,
+    /// Seed of the Poisson gaps.
+    pub seed: u64,
+    /// Longest a request may take from its intended send time.
+    pub timeout: Duration,
+    /// Sent as `Authorization: Bearer <key>`.
+    pub api_key: Option<String>,
+}
+
+/// The figures of a run, as `--out` writes them.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    /// Intended requests per second.
+    pub target_rate: f64,
+    /// 2xx responses recorded per second of the measured duration.
+    pub achieved_rate: f64,
+    /// Measured duration, seconds: from the start of the window to the last
+    /// recorded response, at least the configured duration.
+    pub duration_s: f64,
+    /// Requests intended in the window: 2xx + errors + shed.
+    pub requests: u64,
+    /// Transport errors, timeouts and non-2xx statuses other than 503.
+    pub errors: u64,
+    /// 503 responses (load shedding).
+    pub shed: u64,
+    /// Median latency of the 2xx responses, ms (from the intended time).
+    pub p50_ms: f64,
+    /// 90th percentile, ms.
+    pub p90_ms: f64,
+    /// 99th percentile, ms.
+    pub p99_ms: f64,
+    /// 99.9th percentile, ms.
+    pub p999_ms: f64,
+    /// Largest latency, ms.
+    pub max_ms: f64,
+}
+
+/// Everything measured in a run.
+#[derive(Debug, Clone)]
+pub struct RunReport {
+    /// The headline figures.
+    pub summary: Summary,
+    /// Arrival process used.
+    pub arrivals: Arrivals,
+    /// Latency of the recorded 2xx responses, µs from the intended time.
+    pub latency: Histogram<u64>,
+    /// Wait before sending of every request in the window, µs from the
+    /// intended time to the moment a connection took it: the dispatcher's
+    /// lateness plus the queueing for a free connection. Large values mean
+    /// the generator (or its number of connections) is the bottleneck.
+    pub send_wait: Histogram<u64>,
+    /// 2xx responses recorded.
+    pub ok: u64,
+    /// Non-2xx statuses other than 503.
+    pub status_errors: u64,
+    /// Connection and protocol errors.
+    pub transport_errors: u64,
+    /// Requests that reached the timeout (queued or in flight).
+    pub timeouts: u64,
+    /// Requests sent over the whole run, warm-up included.
+    pub sent: u64,
+    /// The first error seen, for the report.
+    pub first_error: Option<String>,
+}
+
+impl RunReport {
+    /// A short human-readable report, several lines.
+    pub fn describe(&self) -> String {
+        let s = &self.summary;
+        let mut out = format!(
+            "target {:.1}/s ({}), achieved {:.1}/s over {:.2} s: {} requests, {} ok, {} errors, {} shed\n",
+            s.target_rate,
+            self.arrivals,
+            s.achieved_rate,
+            s.duration_s,
+            s.requests,
+            self.ok,
+            s.errors,
+            s.shed
+        );
+        out += &format!(
+            "latency ms from the intended send time: p50 {:.3}  p90 {:.3}  p99 {:.3}  p99.9 {:.3}  max {:.3}\n",
+            s.p50_ms, s.p90_ms, s.p99_ms, s.p999_ms, s.max_ms
+        );
+        out += &format!(
+            "send wait ms (generator lateness + queueing for a connection): p50 {:.3}  p99 {:.3}  max {:.3}",
+            ms(&self.send_wait, 0.5),
+            ms(&self.send_wait, 0.99),
+            max_ms(&self.send_wait)
+        );
+        if s.errors > 0 {
+            out += &format!(
+                "\nerrors: {} bad status, {} transport, {} timeouts; first: {}",
+                self.status_errors,
+                self.transport_errors,
+                self.timeouts,
+                self.first_error.as_deref().unwrap_or("-")
+            );
+        }
+        out
+    }
+}
+
+fn ms(h: &Histogram<u64>, q: f64) -> f64 {
+    if h.is_empty() {
+        0.0
+    } else {
+        h.value_at_quantile(q) as f64 / 1e3
+    }
+}
+
+fn max_ms(h: &Histogram<u64>) -> f64 {
+    if h.is_empty() {
+        0.0
+    } else {
+        h.max() as f64 / 1e3
+    }
+}
+
+/// A latency histogram in microseconds, 3 significant digits, up to an hour
+/// (larger values saturate).
+fn histogram() -> Result<Histogram<u64>> {
+    Histogram::new_with_bounds(1, 3_600_000_000, 3).context("cannot create a histogram")
+}
+
+/// Microseconds of `d`, at least 1 (the histogram's lowest value).
+fn micros(d: Duration) -> u64 {
+    u64::try_from(d.as_micros()).unwrap_or(u64::MAX).max(1)
+}
+
+/// The HTTP client of a run: HTTP/1.1, no proxy, Nagle off, up to
+/// `connections` kept-alive connections.
+///
+/// # Errors
+/// If the client cannot be built.
+pub fn client(connections: usize) -> Result<reqwest::Client> {
+    reqwest::Client::builder()
+        .no_proxy()
+        .tcp_nodelay(true)
+        .pool_max_idle_per_host(connections.max(1))
+        .build()
+        .context("cannot build the HTTP client")
+}
+
+fn auth_header(api_key: Option<&str>) -> Result<Option<HeaderValue>> {
+    api_key
+        .map(|k| {
+            HeaderValue::from_str(&format!("Bearer {k}"))
+                .context("the API key is not a valid header value")
+        })
+        .transpose()
+}
+
+fn request(
+    client: &reqwest::Client,
+    target: &Target,
+    seq: u64,
+    auth: Option<&HeaderValue>,
+) -> reqwest::RequestBuilder {
+    let rb = match target {
+        Target::Post { url, bodies } => {
+            let body = bodies[(seq % bodies.len() as u64) as usize].clone();
+            client
+                .post(url)
+                .header(CONTENT_TYPE, HeaderValue::from_static("application/json"))
+                .body(body)
+        }
+        Target::Get { url } => client.get(url),
+    };
+    match auth {
+        Some(a) => rb.header(AUTHORIZATION, a.clone()),
+        None => rb,
+    }
+}
+
+/// Sends the first request once and checks it succeeds, so that a wrong
+/// URL, scenario, key or body fails at once with a clear message rather
+/// than as a run full of errors.
+///
+/// # Errors
+/// If the server cannot be reached or does not answer 2xx.
+pub async fn preflight(target: &Target, api_key: Option<&str>, timeout: Duration) -> Result<()> {
+    let client = client(1)?;
+    let auth = auth_header(api_key)?;
+    let res = request(&client, target, 0, auth.as_ref())
+        .timeout(timeout)
+        .send()
+        .await
+        .with_context(|| format!("cannot reach {}", target.url()))?;
+    let status = res.status();
+    if !status.is_success() {
+        let body = res.text().await.unwrap_or_default();
+        let body: String = body.chars().take(500).collect();
+        bail!("{} answered {status}: {body}", target.url());
+    }
+    res.bytes()
+        .await
+        .with_context(|| format!("reading the answer of {}", target.url()))?;
+    Ok(())
+}
+
+/// A request handed to a worker.
+#[derive(Debug, Clone, Copy)]
+struct Job {
+    seq: u64,
+    intended: Instant,
+    measured: bool,
+}
+
+/// What the workers record, shared (the lock is held for a few
+/// instructions per response).
+struct Recorder {
+    latency: Histogram<u64>,
+    send_wait: Histogram<u64>,
+    ok: u64,
+    shed: u64,
+    status_errors: u64,
+    transport_errors: u64,
+    timeouts: u64,
+    sent: u64,
+    last_ok: Option<Instant>,
+    first_error: Option<String>,
+}
+
+impl Recorder {
+    fn error(&mut self, msg: impl FnOnce() -> String) {
+        if self.first_error.is_none() {
+            self.first_error = Some(msg());
+        }
+    }
+}
+
+/// Runs `cfg` on the current tokio runtime and reports it.
+///
+/// The intended times are `[0, warmup + duration)` from the start; requests
+/// intended in `[warmup, warmup + duration)` are measured. The run returns
+/// once every request has been answered or has timed out.
+///
+/// # Errors
+/// If the configuration is invalid (rate, connections, API key) or the
+/// HTTP client cannot be built. Failed requests are not errors of the run:
+/// they are counted in the report.
+pub async fn run(cfg: &RunConfig) -> Result<RunReport> {
+    if cfg.connections == 0 {
+        bail!("--connections must be at least 1");
+    }
+    if cfg.duration.is_zero() {
+        bail!("--duration must be positive");
+    }
+    if cfg.timeout.is_zero() {
+        bail!("--timeout must be positive");
+    }
+    let warmup_s = cfg.warmup.as_secs_f64();
+    let schedule = Schedule::new(
+        cfg.arrivals,
+        cfg.rate,
+        warmup_s + cfg.duration.as_secs_f64(),
+        cfg.seed,
+    )?;
+    let client = client(cfg.connections)?;
+    let auth = auth_header(cfg.api_key.as_deref())?;
+    let recorder = Arc::new(Mutex::new(Recorder {
+        latency: histogram()?,
+        send_wait: histogram()?,
+        ok: 0,
+        shed: 0,
+        status_errors: 0,
+        transport_errors: 0,
+        timeouts: 0,
+        sent: 0,
+        last_ok: None,
+        first_error: None,
+    }));
+
+    let (tx, rx) = mpsc::unbounded_channel::<Job>();
+    let rx = Arc::new(tokio::sync::Mutex::new(rx));
+    let target = Arc::new(cfg.target.clone());
+    let mut workers = Vec::with_capacity(cfg.connections);
+    for _ in 0..cfg.connections {
+        let (client, target, rx, recorder, auth) = (
+            client.clone(),
+            Arc::clone(&target),
+            Arc::clone(&rx),
+            Arc::clone(&recorder),
+            auth.clone(),
+        );
+        let timeout = cfg.timeout;
+        workers.push(tokio::spawn(async move {
+            worker(client, target, rx, recorder, auth, timeout).await;
+        }));
+    }
+
+    // A little lead so that the workers are waiting when the first request
+    // is due.
+    let start = Instant::now() + Duration::from_millis(20);
+    let window_start = start + cfg.warmup;
+    let dispatcher = std::thread::Builder::new()
+        .name("vigil-loadtest-dispatch".into())
+        .spawn(move || dispatch(schedule, start, warmup_s, tx))
+        .context("cannot start the dispatcher thread")?;
+
+    for w in workers {
+        w.await.context("a worker task failed")?;
+    }
+    // The workers only stop once the dispatcher has dropped the queue's
+    // sender, so this does not block.
+    if dispatcher.join().is_err() {
+        bail!("the dispatcher thread panicked");
+    }
+
+    let rec = Arc::try_unwrap(recorder)
+        .map_err(|_| anyhow::anyhow!("a worker outlived the run"))?
+        .into_inner()
+        .unwrap_or_else(PoisonError::into_inner);
+    let configured = cfg.duration.as_secs_f64();
+    let duration_s = rec
+        .last_ok
+        .map(|t| t.saturating_duration_since(window_start).as_secs_f64())
+        .unwrap_or(0.0)
+        .max(configured);
+    let errors = rec.status_errors + rec.transport_errors + rec.timeouts;
+    let summary = Summary {
+        target_rate: cfg.rate,
+        achieved_rate: rec.ok as f64 / duration_s,
+        duration_s,
+        requests: rec.ok + errors + rec.shed,
+        errors,
+        shed: rec.shed,
+        p50_ms: ms(&rec.latency, 0.5),
+        p90_ms: ms(&rec.latency, 0.9),
+        p99_ms: ms(&rec.latency, 0.99),
+        p999_ms: ms(&rec.latency, 0.999),
+        max_ms: max_ms(&rec.latency),
+    };
+    Ok(RunReport {
+        summary,
+        arrivals: cfg.arrivals,
+        latency: rec.latency,
+        send_wait: rec.send_wait,
+        ok: rec.ok,
+        status_errors: rec.status_errors,
+        transport_errors: rec.transport_errors,
+        timeouts: rec.timeouts,
+        sent: rec.sent,
+        first_error: rec.first_error,
+    })
+}
+
+/// Sleeps until each intended time and queues its request.
+fn dispatch(schedule: Schedule, start: Instant, warmup_s: f64, tx: mpsc::UnboundedSender<Job>) {
+    for (seq, t) in (0u64..).zip(schedule) {
+        let intended = start + Duration::from_secs_f64(t);
+        let now = Instant::now();
+        if intended > now {
+            std::thread::sleep(intended - now);
+        }
+        let job = Job {
+            seq,
+            intended,
+            measured: t >= warmup_s,
+        };
+        if tx.send(job).is_err() {
+            return;
+        }
+    }
+}
+
+fn lock(r: &Mutex<Recorder>) -> std::sync::MutexGuard<'_, Recorder> {
+    r.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// One connection: takes the next queued request, sends it, records it.
+async fn worker(
+    client: reqwest::Client,
+    target: Arc<Target>,
+    rx: Arc<tokio::sync::Mutex<mpsc::UnboundedReceiver<Job>>>,
+    recorder: Arc<Mutex<Recorder>>,
+    auth: Option<HeaderValue>,
+    timeout: Duration,
+) {
+    loop {
+        let next = { rx.lock().await.recv().await };
+        let Some(job) = next else { return };
+        let taken = Instant::now();
+        let waited = taken.saturating_duration_since(job.intended);
+        if job.measured {
+            lock(&recorder).send_wait.saturating_record(micros(waited));
+        }
+        if waited >= timeout {
+            // Waited its whole budget in the queue: not sent.
+            if job.measured {
+                let mut r = lock(&recorder);
+                r.timeouts += 1;
+                r.error(|| format!("timed out after {timeout:?} waiting for a connection"));
+            }
+            continue;
+        }
+        let outcome = async {
+            let res = request(&client, &target, job.seq, auth.as_ref())
+                .timeout(timeout - waited)
+                .send()
+                .await?;
+            let status = res.status();
+            res.bytes().await?;
+            Ok::<_, reqwest::Error>(status)
+        }
+        .await;
+        let done = Instant::now();
+        let mut r = lock(&recorder);
+        r.sent += 1;
+        if !job.measured {
+            continue;
+        }
+        match outcome {
+            Ok(status) if status.is_success() => {
+                r.ok += 1;
+                r.latency
+                    .saturating_record(micros(done.saturating_duration_since(job.intended)));
+                r.last_ok = Some(r.last_ok.map_or(done, |t| t.max(done)));
+            }
+            Ok(status) if status == reqwest::StatusCode::SERVICE_UNAVAILABLE => r.shed += 1,
+            Ok(status) => {
+                r.status_errors += 1;
+                r.error(|| format!("status {status}"));
+            }
+            Err(e) if e.is_timeout() => {
+                r.timeouts += 1;
+                r.error(|| format!("timed out after {timeout:?}: {e}"));
+            }
+            Err(e) => {
+                r.transport_errors += 1;
+                r.error(|| format!("{e}"));
+            }
+        }
+    }
+}

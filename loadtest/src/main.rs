@@ -1,0 +1,472 @@
+//! `vigil-loadtest`: open-loop load against a Vigil server (see the crate's
+//! README for the method).
+//!
+//! ```text
+//! vigil-loadtest [OPTIONS]                 one run, or --sweep
+//! vigil-loadtest gen --out FILE [...]      write generated request bodies
+//! vigil-loadtest inproc [...]              in-process plan time of the same requests
+//! vigil-loadtest summarize [...]           combine run.sh's results, HTTP efficiency
+//! ```
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use serde::Serialize;
+use vigil::planner::PlanRequest;
+
+use vigil_loadtest::generator::{self, RunConfig, Target};
+use vigil_loadtest::inproc;
+use vigil_loadtest::report::Session;
+use vigil_loadtest::requests;
+use vigil_loadtest::schedule::Arrivals;
+use vigil_loadtest::sweep::{self, SweepConfig};
+use vigil_loadtest::workload::Workload;
+
+/// Open-loop load generator for the Vigil planning API.
+///
+/// Without a subcommand, replays plan requests (generated from vigil-sim
+/// states, or read with --requests) at --rate per second, open loop: the
+/// send times are fixed in advance and latency runs from each request's
+/// intended send time, so queueing in the generator counts. With --sweep,
+/// climbs the rate until p99 passes --slo-ms and reports the knee.
+#[derive(Debug, Parser)]
+#[command(
+    name = "vigil-loadtest",
+    version,
+    args_conflicts_with_subcommands = true
+)]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Option<Cmd>,
+    #[command(flatten)]
+    run: RunArgs,
+}
+
+#[derive(Debug, Subcommand)]
+enum Cmd {
+    /// Generate request bodies from vigil-sim states and write them to a
+    /// file (a JSON array, or JSON lines if it ends in .jsonl/.ndjson).
+    Gen(GenArgs),
+    /// Time the same requests in process (single thread, no HTTP): the
+    /// median feeds the HTTP efficiency.
+    Inproc(InprocArgs),
+    /// Combine the results of run.sh (each file optional) and derive the
+    /// HTTP efficiency.
+    Summarize(SummarizeArgs),
+}
+
+/// Which endpoint a run hits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum Endpoint {
+    /// POST /v1/scenarios/{scenario}/plan with the request bodies.
+    Plan,
+    /// GET /healthz: the HTTP stack's ceiling.
+    Healthz,
+}
+
+/// The requests: generated from vigil-sim states.
+#[derive(Debug, Args)]
+struct WorkloadArgs {
+    /// Built-in scenario: requests are generated for it and sent to it.
+    #[arg(long, default_value = "paper-v10")]
+    scenario: String,
+    /// Sensors per generated request.
+    #[arg(long, default_value_t = 10)]
+    sensors: usize,
+    /// Steps of history per generated request.
+    #[arg(long, default_value_t = 16)]
+    history: usize,
+    /// Horizon T of the generated requests.
+    #[arg(long, default_value_t = 3)]
+    horizon: usize,
+    /// Distinct requests to generate (consecutive steps of one simulation).
+    #[arg(long, default_value_t = 100)]
+    count: usize,
+    /// Seed of the simulated target process, and of the Poisson arrivals.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+}
+
+impl WorkloadArgs {
+    fn workload(&self) -> Workload {
+        Workload {
+            sensors: self.sensors,
+            history: self.history,
+            horizon: self.horizon,
+            seed: self.seed,
+        }
+    }
+
+    /// The requests: read from `file`, or generated.
+    fn requests(&self, file: Option<&Path>) -> Result<Vec<PlanRequest>> {
+        match file {
+            Some(f) => requests::load(f),
+            None => {
+                let planner = requests::planner_for(&self.scenario)?;
+                let t = Instant::now();
+                let reqs = requests::generate(&planner, &self.workload(), self.count)?;
+                eprintln!(
+                    "generated {} requests ({} sensors, {} steps of history, T = {}, mean {:.1} targets) in {:.1} s",
+                    reqs.len(),
+                    self.sensors,
+                    self.history,
+                    self.horizon,
+                    mean_targets(&reqs),
+                    t.elapsed().as_secs_f64()
+                );
+                Ok(reqs)
+            }
+        }
+    }
+}
+
+fn mean_targets(reqs: &[PlanRequest]) -> f64 {
+    reqs.iter().map(|r| r.targets.len()).sum::<usize>() as f64 / reqs.len().max(1) as f64
+}
+
+#[derive(Debug, Args)]
+struct RunArgs {
+    /// Base URL of the server (http only).
+    #[arg(long, default_value = "http://127.0.0.1:8080")]
+    url: String,
+    /// Endpoint to load.
+    #[arg(long, value_enum, default_value_t = Endpoint::Plan)]
+    endpoint: Endpoint,
+    /// Intended requests per second.
+    #[arg(long, default_value_t = 100.0)]
+    rate: f64,
+    /// Arrival process.
+    #[arg(long, value_enum, default_value_t = Arrivals::Poisson)]
+    arrivals: Arrivals,
+    /// Measured duration (e.g. 30, 30s, 500ms, 2m).
+    #[arg(long, default_value = "10s", value_parser = parse_duration)]
+    duration: Duration,
+    /// Warm-up before it: sent, not recorded.
+    #[arg(long, default_value = "2s", value_parser = parse_duration)]
+    warmup: Duration,
+    /// Concurrent connections. A request waits in the generator's queue
+    /// while all are busy, and the wait counts in its latency.
+    #[arg(long, default_value_t = 32)]
+    connections: usize,
+    /// Longest a request may take from its intended send time; past it, it
+    /// counts as an error.
+    #[arg(long, default_value = "5s", value_parser = parse_duration)]
+    timeout: Duration,
+    /// File of plan request bodies (a JSON array, or JSON lines); generated
+    /// from vigil-sim states when absent.
+    #[arg(long)]
+    requests: Option<PathBuf>,
+    /// API key, sent as `Authorization: Bearer <key>`.
+    #[arg(long, env = "VIGIL_API_KEY", hide_env_values = true)]
+    api_key: Option<String>,
+    /// Runtime threads of the generator (1: a current-thread runtime, for a
+    /// generator pinned to one core).
+    #[arg(long, default_value_t = 1)]
+    threads: usize,
+    /// Write the figures as JSON to this file (with --sweep: every step and
+    /// the knee).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Climb the rate until p99 passes --slo-ms, and report the knee.
+    #[arg(long)]
+    sweep: bool,
+    /// SLO on the p99 latency, ms (for --sweep).
+    #[arg(long, default_value_t = 2.0)]
+    slo_ms: f64,
+    /// First rate of the sweep.
+    #[arg(long, default_value_t = 100.0)]
+    sweep_start: f64,
+    /// Rate multiplier between sweep steps.
+    #[arg(long, default_value_t = 1.25)]
+    sweep_factor: f64,
+    /// Highest rate of the sweep.
+    #[arg(long, default_value_t = 100_000.0)]
+    sweep_max: f64,
+    /// Bisection steps between the last passing and the first failing rate.
+    #[arg(long, default_value_t = 0)]
+    sweep_refine: u32,
+    /// Least achieved / target rate of a step that meets the SLO.
+    #[arg(long, default_value_t = 0.95)]
+    sweep_min_achieved: f64,
+    /// Idle time between sweep steps.
+    #[arg(long, default_value = "1s", value_parser = parse_duration)]
+    sweep_pause: Duration,
+    #[command(flatten)]
+    workload: WorkloadArgs,
+}
+
+#[derive(Debug, Args)]
+struct GenArgs {
+    /// File to write (JSON lines if it ends in .jsonl or .ndjson).
+    #[arg(long)]
+    out: PathBuf,
+    #[command(flatten)]
+    workload: WorkloadArgs,
+}
+
+#[derive(Debug, Args)]
+struct InprocArgs {
+    /// File of plan request bodies; generated when absent.
+    #[arg(long)]
+    requests: Option<PathBuf>,
+    /// Timed plans, cycling through the requests.
+    #[arg(long, default_value_t = 2000)]
+    iterations: usize,
+    /// Write the figures as JSON to this file.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    #[command(flatten)]
+    workload: WorkloadArgs,
+}
+
+#[derive(Debug, Args)]
+struct SummarizeArgs {
+    /// Cores the server was pinned to.
+    #[arg(long, default_value_t = 1.0)]
+    server_cores: f64,
+    /// `inproc --out` file.
+    #[arg(long)]
+    inproc: Option<PathBuf>,
+    /// `--endpoint healthz --sweep --out` file.
+    #[arg(long)]
+    healthz_sweep: Option<PathBuf>,
+    /// Fixed-rate plan run `--out` file.
+    #[arg(long)]
+    fixed: Option<PathBuf>,
+    /// Plan `--sweep --out` file.
+    #[arg(long)]
+    plan_sweep: Option<PathBuf>,
+    /// Write the combined figures as JSON to this file.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+/// `30`, `30s`, `2.5s`, `500ms` or `2m`.
+fn parse_duration(s: &str) -> Result<Duration, String> {
+    let s = s.trim();
+    let (num, scale) = if let Some(n) = s.strip_suffix("ms") {
+        (n, 1e-3)
+    } else if let Some(n) = s.strip_suffix('s') {
+        (n, 1.0)
+    } else if let Some(n) = s.strip_suffix('m') {
+        (n, 60.0)
+    } else {
+        (s, 1.0)
+    };
+    let v: f64 = num
+        .trim()
+        .parse()
+        .map_err(|_| format!("{s:?} is not a duration (e.g. 30, 30s, 500ms, 2m)"))?;
+    Duration::try_from_secs_f64(v * scale).map_err(|_| format!("{s:?} is not a valid duration"))
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.cmd {
+        Some(Cmd::Gen(a)) => gen_cmd(&a),
+        Some(Cmd::Inproc(a)) => inproc_cmd(&a),
+        Some(Cmd::Summarize(a)) => summarize_cmd(&a),
+        None => run_cmd(&cli.run),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("vigil-loadtest: error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
+    let mut text = serde_json::to_string_pretty(value)?;
+    text.push('\n');
+    std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))
+}
+
+fn gen_cmd(a: &GenArgs) -> Result<()> {
+    let reqs = a.workload.requests(None)?;
+    requests::save(&a.out, &reqs)?;
+    println!("wrote {} requests to {}", reqs.len(), a.out.display());
+    Ok(())
+}
+
+fn inproc_cmd(a: &InprocArgs) -> Result<()> {
+    let planner = requests::planner_for(&a.workload.scenario)?;
+    let reqs = a.workload.requests(a.requests.as_deref())?;
+    let r = inproc::measure(&planner, &reqs, a.iterations)?;
+    println!(
+        "in process, {} plans of {} requests (mean {:.1} targets) on {}: median {:.3} ms  p90 {:.3}  p99 {:.3}  mean {:.3}  max {:.3}  => {:.0} plans/s per core",
+        r.iterations,
+        r.requests,
+        mean_targets(&reqs),
+        planner.scenario.id,
+        r.median_ms,
+        r.p90_ms,
+        r.p99_ms,
+        r.mean_ms,
+        r.max_ms,
+        r.plans_per_s_per_core
+    );
+    if let Some(out) = &a.out {
+        write_json(out, &r)?;
+    }
+    Ok(())
+}
+
+fn summarize_cmd(a: &SummarizeArgs) -> Result<()> {
+    if !(a.server_cores.is_finite() && a.server_cores > 0.0) {
+        bail!("--server-cores must be positive");
+    }
+    let s = Session::from_files(
+        a.server_cores,
+        a.inproc.as_deref(),
+        a.healthz_sweep.as_deref(),
+        a.fixed.as_deref(),
+        a.plan_sweep.as_deref(),
+    )?;
+    println!("{}", s.describe());
+    if let Some(out) = &a.out {
+        write_json(out, &s)?;
+    }
+    Ok(())
+}
+
+fn run_cmd(a: &RunArgs) -> Result<()> {
+    let url = reqwest::Url::parse(&a.url).with_context(|| format!("--url {:?}", a.url))?;
+    if url.scheme() != "http" {
+        bail!(
+            "--url {:?}: only http:// is supported (built without TLS)",
+            a.url
+        );
+    }
+    if a.threads == 0 {
+        bail!("--threads must be at least 1");
+    }
+    let target = match a.endpoint {
+        Endpoint::Healthz => Target::healthz(&a.url),
+        Endpoint::Plan => {
+            let reqs = a.workload.requests(a.requests.as_deref())?;
+            Target::plan(&a.url, &a.workload.scenario, requests::bodies(&reqs)?)?
+        }
+    };
+    let cfg = RunConfig {
+        target,
+        rate: a.rate,
+        arrivals: a.arrivals,
+        duration: a.duration,
+        warmup: a.warmup,
+        connections: a.connections,
+        seed: a.workload.seed,
+        timeout: a.timeout,
+        api_key: a.api_key.clone().filter(|k| !k.is_empty()),
+    };
+    let runtime = if a.threads == 1 {
+        tokio::runtime::Builder::new_current_thread()
+            .enable_all()
+            .build()
+    } else {
+        tokio::runtime::Builder::new_multi_thread()
+            .worker_threads(a.threads)
+            .enable_all()
+            .build()
+    }
+    .context("cannot start the tokio runtime")?;
+    runtime.block_on(async {
+        generator::preflight(&cfg.target, cfg.api_key.as_deref(), cfg.timeout).await?;
+        if a.sweep {
+            let sc = SweepConfig {
+                start: a.sweep_start,
+                factor: a.sweep_factor,
+                max: a.sweep_max,
+                slo_ms: a.slo_ms,
+                min_achieved: a.sweep_min_achieved,
+                refine: a.sweep_refine,
+                pause: a.sweep_pause,
+            };
+            eprintln!(
+                "sweep of {} from {}/s ×{} up to {}/s, {:?} per step (+{:?} warm-up), SLO p99 ≤ {} ms",
+                cfg.target.url(),
+                sc.start,
+                sc.factor,
+                sc.max,
+                cfg.duration,
+                cfg.warmup,
+                sc.slo_ms
+            );
+            let report = sweep::sweep(&cfg, &sc, |r| {
+                let s = &r.summary;
+                let verdict = if sweep::meets_slo(s, sc.slo_ms, sc.min_achieved) {
+                    "ok"
+                } else {
+                    "FAIL"
+                };
+                println!(
+                    "{:>10.1}/s -> {:>10.1}/s  p50 {:>8.3}  p99 {:>8.3}  p99.9 {:>8.3}  max {:>8.3} ms  errors {}  shed {}  wait p99 {:.3} ms  {verdict}",
+                    s.target_rate,
+                    s.achieved_rate,
+                    s.p50_ms,
+                    s.p99_ms,
+                    s.p999_ms,
+                    s.max_ms,
+                    s.errors,
+                    s.shed,
+                    r.send_wait.value_at_quantile(0.99) as f64 / 1e3
+                );
+            })
+            .await?;
+            match &report.knee {
+                Some(k) => println!(
+                    "knee: {:.1}/s target, {:.1}/s achieved, p99 {:.3} ms ({})",
+                    k.target_rate, k.achieved_rate, k.p99_ms, report.stopped
+                ),
+                None => println!(
+                    "knee: none, the first step ({}/s) failed the SLO; lower --sweep-start or raise --slo-ms",
+                    sc.start
+                ),
+            }
+            if let Some(out) = &a.out {
+                write_json(out, &report)?;
+            }
+        } else {
+            eprintln!(
+                "{} at {}/s ({}) for {:?} after {:?} of warm-up, {} connections",
+                cfg.target.url(),
+                cfg.rate,
+                cfg.arrivals,
+                cfg.duration,
+                cfg.warmup,
+                cfg.connections
+            );
+            let report = generator::run(&cfg).await?;
+            println!("{}", report.describe());
+            if let Some(out) = &a.out {
+                write_json(out, &report.summary)?;
+            }
+        }
+        Ok(())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn durations_parse_with_and_without_units() {
+        assert_eq!(parse_duration("30").unwrap(), Duration::from_secs(30));
+        assert_eq!(parse_duration("2.5s").unwrap(), Duration::from_millis(2500));
+        assert_eq!(parse_duration("500ms").unwrap(), Duration::from_millis(500));
+        assert_eq!(parse_duration("2m").unwrap(), Duration::from_secs(120));
+        assert!(parse_duration("fast").is_err());
+        assert!(parse_duration("-1").is_err());
+    }
+
+    #[test]
+    fn the_cli_is_consistent() {
+        use clap::CommandFactory;
+        Cli::command().debug_assert();
+    }
+}

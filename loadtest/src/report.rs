@@ -1,0 +1,249 @@
+//! The summary of a whole `run.sh` session: the `/healthz` ceiling, the
+//! in-process median, the fixed-rate run, the plan knee, and the HTTP
+//! efficiency derived from them.
+
+use std::fs;
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
+
+use crate::generator::Summary;
+use crate::inproc::{self, InprocReport};
+use crate::sweep::SweepReport;
+
+/// Everything `run.sh` measured, as `summarize --out` writes it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Session {
+    /// Cores the server was pinned to.
+    pub server_cores: f64,
+    /// The in-process plan times of the same requests.
+    pub inproc: Option<InprocReport>,
+    /// `/healthz`: the highest rate that met the SLO.
+    pub healthz_knee_rate: Option<f64>,
+    /// `/healthz`: the highest achieved rate of any step (the ceiling of
+    /// the HTTP stack, or of the generator if that saturated first).
+    pub healthz_max_achieved: Option<f64>,
+    /// The fixed-rate plan run.
+    pub fixed: Option<Summary>,
+    /// The SLO of the plan sweep, ms.
+    pub slo_ms: Option<f64>,
+    /// Plans: the step at the knee.
+    pub plan_knee: Option<Summary>,
+    /// Plans: the highest achieved rate of any run (the sweep's steps and
+    /// the fixed-rate run).
+    pub plan_max_achieved: Option<f64>,
+    /// Achieved plan rate at the knee per server core, divided by
+    /// `1 / inproc median`.
+    pub http_efficiency: Option<f64>,
+    /// The same at the highest achieved plan rate of any run (the
+    /// saturation throughput when a run overloaded the server, whatever its
+    /// latency).
+    pub http_efficiency_at_max: Option<f64>,
+}
+
+fn read<T: DeserializeOwned>(path: Option<&Path>) -> Result<Option<T>> {
+    path.map(|p| {
+        let text = fs::read_to_string(p).with_context(|| format!("cannot read {}", p.display()))?;
+        serde_json::from_str(&text)
+            .with_context(|| format!("{} is not the expected JSON", p.display()))
+    })
+    .transpose()
+}
+
+fn max_achieved(s: &SweepReport) -> Option<f64> {
+    s.steps.iter().map(|x| x.achieved_rate).reduce(f64::max)
+}
+
+impl Session {
+    /// Reads the results files given (each optional) and derives the
+    /// efficiency.
+    ///
+    /// # Errors
+    /// If a file given cannot be read or parsed.
+    pub fn from_files(
+        server_cores: f64,
+        inproc: Option<&Path>,
+        healthz_sweep: Option<&Path>,
+        fixed: Option<&Path>,
+        plan_sweep: Option<&Path>,
+    ) -> Result<Self> {
+        let inproc: Option<InprocReport> = read(inproc)?;
+        let healthz: Option<SweepReport> = read(healthz_sweep)?;
+        let fixed: Option<Summary> = read(fixed)?;
+        let plan: Option<SweepReport> = read(plan_sweep)?;
+        let plan_knee = plan.as_ref().and_then(|p| p.knee);
+        let http_efficiency = match (plan_knee, inproc) {
+            (Some(k), Some(i)) => Some(inproc::http_efficiency(
+                k.achieved_rate,
+                server_cores,
+                i.median_ms,
+            )),
+            _ => None,
+        };
+        let plan_max_achieved = plan
+            .as_ref()
+            .and_then(max_achieved)
+            .into_iter()
+            .chain(fixed.map(|f| f.achieved_rate))
+            .reduce(f64::max);
+        let http_efficiency_at_max = match (plan_max_achieved, inproc) {
+            (Some(m), Some(i)) => Some(inproc::http_efficiency(m, server_cores, i.median_ms)),
+            _ => None,
+        };
+        Ok(Session {
+            server_cores,
+            inproc,
+            healthz_knee_rate: healthz.as_ref().and_then(|h| h.knee_rate),
+            healthz_max_achieved: healthz.as_ref().and_then(max_achieved),
+            fixed,
+            slo_ms: plan.as_ref().map(|p| p.slo_ms),
+            plan_knee,
+            plan_max_achieved,
+            http_efficiency,
+            http_efficiency_at_max,
+        })
+    }
+
+    /// A human-readable summary, several lines.
+    pub fn describe(&self) -> String {
+        let f = |x: Option<f64>, digits: usize| {
+            x.map_or_else(|| "-".to_owned(), |v| format!("{v:.digits$}"))
+        };
+        let mut out = String::new();
+        out += &format!("server cores: {}\n", self.server_cores);
+        if let Some(i) = &self.inproc {
+            out += &format!(
+                "in process: median {:.3} ms, p90 {:.3}, p99 {:.3} ({:.0} plans/s per core)\n",
+                i.median_ms, i.p90_ms, i.p99_ms, i.plans_per_s_per_core
+            );
+        }
+        out += &format!(
+            "/healthz: knee {}/s, highest achieved {}/s\n",
+            f(self.healthz_knee_rate, 0),
+            f(self.healthz_max_achieved, 0)
+        );
+        if let Some(x) = &self.fixed {
+            out += &format!(
+                "plans at {:.0}/s: achieved {:.1}/s, p50 {:.3} ms, p90 {:.3}, p99 {:.3}, p99.9 {:.3}, max {:.3}, errors {}, shed {}\n",
+                x.target_rate,
+                x.achieved_rate,
+                x.p50_ms,
+                x.p90_ms,
+                x.p99_ms,
+                x.p999_ms,
+                x.max_ms,
+                x.errors,
+                x.shed
+            );
+        }
+        match &self.plan_knee {
+            Some(k) => {
+                out += &format!(
+                    "plan knee (p99 ≤ {} ms): {:.0}/s target, {:.1}/s achieved, p50 {:.3} ms, p99 {:.3}; highest achieved {}/s\n",
+                    f(self.slo_ms, 1),
+                    k.target_rate,
+                    k.achieved_rate,
+                    k.p50_ms,
+                    k.p99_ms,
+                    f(self.plan_max_achieved, 0)
+                )
+            }
+            None => {
+                out += &format!(
+                    "plan knee: none (the first step failed the SLO); highest achieved {}/s\n",
+                    f(self.plan_max_achieved, 0)
+                )
+            }
+        }
+        out += &format!(
+            "HTTP efficiency = (knee throughput / server cores) / (1 / in-process median) = {}",
+            f(self.http_efficiency, 3)
+        );
+        out += &format!(
+            "\n  at the highest plan rate achieved in any run (saturation, any latency): {}",
+            f(self.http_efficiency_at_max, 3)
+        );
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn summary(target: f64, achieved: f64, p99: f64) -> Summary {
+        Summary {
+            target_rate: target,
+            achieved_rate: achieved,
+            duration_s: 10.0,
+            requests: 100,
+            errors: 0,
+            shed: 0,
+            p50_ms: p99 / 2.0,
+            p90_ms: p99,
+            p99_ms: p99,
+            p999_ms: p99,
+            max_ms: p99,
+        }
+    }
+
+    #[test]
+    fn the_session_combines_the_files_and_derives_the_efficiency() {
+        let dir = tempfile::tempdir().unwrap();
+        let write = |name: &str, v: &dyn erased::Json| {
+            let p = dir.path().join(name);
+            fs::write(&p, v.json()).unwrap();
+            p
+        };
+        let inproc = InprocReport {
+            requests: 10,
+            iterations: 100,
+            median_ms: 0.5,
+            p90_ms: 0.6,
+            p99_ms: 0.7,
+            mean_ms: 0.55,
+            min_ms: 0.4,
+            max_ms: 0.8,
+            plans_per_s_per_core: 2000.0,
+        };
+        let sweep = SweepReport {
+            slo_ms: 2.0,
+            min_achieved: 0.95,
+            knee_rate: Some(1600.0),
+            knee: Some(summary(1600.0, 1590.0, 1.8)),
+            stopped: "2000.0/s failed the SLO".into(),
+            steps: vec![summary(1600.0, 1590.0, 1.8), summary(2000.0, 1700.0, 40.0)],
+        };
+        let i = write("i.json", &inproc);
+        let p = write("p.json", &sweep);
+        let s = Session::from_files(1.0, Some(&i), None, None, Some(&p)).unwrap();
+        // 1590/s on one core × 0.5 ms = 0.795.
+        assert!((s.http_efficiency.unwrap() - 0.795).abs() < 1e-9);
+        assert_eq!(s.plan_max_achieved, Some(1700.0));
+        assert!((s.http_efficiency_at_max.unwrap() - 0.85).abs() < 1e-9);
+        assert!(s.describe().contains("0.795"), "{}", s.describe());
+        // The fixed-rate run counts towards the highest achieved rate.
+        let f = write("f.json", &summary(2000.0, 1800.0, 90.0));
+        let s = Session::from_files(2.0, Some(&i), None, Some(&f), Some(&p)).unwrap();
+        assert_eq!(s.plan_max_achieved, Some(1800.0));
+        assert!((s.http_efficiency_at_max.unwrap() - 0.45).abs() < 1e-9);
+        assert!((s.http_efficiency.unwrap() - 0.3975).abs() < 1e-9);
+        assert_eq!(s.healthz_knee_rate, None);
+        let missing = dir.path().join("none.json");
+        assert!(Session::from_files(1.0, Some(&missing), None, None, None).is_err());
+    }
+
+    /// Serialising test values of different types through one closure.
+    mod erased {
+        pub trait Json {
+            fn json(&self) -> String;
+        }
+        impl<T: serde::Serialize> Json for T {
+            fn json(&self) -> String {
+                serde_json::to_string(self).unwrap()
+            }
+        }
+    }
+}
