@@ -63,8 +63,13 @@ pub async fn on_rayon<T: Send + 'static>(
 ) -> Result<T, ApiError> {
     let (tx, rx) = tokio::sync::oneshot::channel();
     rayon::spawn(move || {
-        // A panic becomes a 500 (rayon would abort the process); the
-        // receiver is gone only if the request was dropped.
+        // A request dropped while queued (client gone, timed out) is not
+        // planned: under overload, dead work would otherwise fill the queue
+        // and starve the live requests.
+        if tx.is_closed() {
+            return;
+        }
+        // A panic becomes a 500 (rayon would abort the process).
         let _ = tx.send(std::panic::catch_unwind(std::panic::AssertUnwindSafe(work)));
     });
     match rx.await {
