@@ -439,7 +439,7 @@ struct Window {
 /// `U(k,t) = d̂_k − Σ_j λ_j/(πv) ∫ |R_k(α) ∩ ⋃_s (O_s(α) + v(t+s))| dα`:
 /// the closed-form stationary count less the seen part, measured on each
 /// ray by interval arithmetic and integrated over `α` by the midpoint rule on
-/// a fixed grid of [`RAYS_PER_PI`] rays per π. Excluded regions are removed
+/// a fixed grid of rays per π ([`RAYS_PER_PI_SQUARE`] or [`RAYS_PER_PI`]). Excluded regions are removed
 /// the same way (unshifted), and known targets inside them are not counted.
 ///
 /// Two evaluations of the same integral:
