@@ -182,27 +182,49 @@ impl SourceRays {
     /// intersect each ray with the region anyway).
     fn range(&self, region: &Region, buf: &mut Vec<Point>) -> Option<(usize, usize)> {
         let (lo, hi, margin) = if region.disk.is_none() {
-            // The corners' angles, to within 5e-4 rad, then that and one ray
-            // more on each side: cheaper than atan2 for the many squares of
-            // a history.
+            // The extreme corners' angles, to within 5e-4 rad, then that and
+            // one ray more on each side: cheaper than atan2 for the many
+            // squares of a history.
             let h = self.source.heading.unit();
             let o = self.source.pos;
             let r = &region.rect;
-            let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-            for (x, y) in [(r.x0, r.y0), (r.x1, r.y0), (r.x1, r.y1), (r.x0, r.y1)] {
+            let angle = |(x, y): (f64, f64)| {
                 let (dx, dy) = (x - o.x, y - o.y);
-                let a = approx_atan2(h.x * dy - h.y * dx, h.x * dx + h.y * dy);
-                lo = lo.min(a);
-                hi = hi.max(a);
-            }
+                approx_atan2(h.x * dy - h.y * dx, h.x * dx + h.y * dy)
+            };
+            // Seen from outside, two corners bound the rectangle's angles:
+            // the ones on the diagonal the source does not face.
+            let (left, right) = (o.x < r.x0, o.x > r.x1);
+            let (below, above) = (o.y < r.y0, o.y > r.y1);
+            let pair = match (left, right, below, above) {
+                (true, _, true, _) | (_, true, _, true) => Some(((r.x1, r.y0), (r.x0, r.y1))),
+                (true, _, _, true) | (_, true, true, _) => Some(((r.x0, r.y0), (r.x1, r.y1))),
+                (true, _, false, false) => Some(((r.x0, r.y0), (r.x0, r.y1))),
+                (_, true, false, false) => Some(((r.x1, r.y0), (r.x1, r.y1))),
+                (false, false, true, _) => Some(((r.x0, r.y0), (r.x1, r.y0))),
+                (false, false, _, true) => Some(((r.x0, r.y1), (r.x1, r.y1))),
+                (false, false, false, false) => None,
+            };
+            let (lo, hi) = match pair {
+                Some((c0, c1)) => {
+                    let (a0, a1) = (angle(c0), angle(c1));
+                    (a0.min(a1), a0.max(a1))
+                }
+                // The source inside the rectangle: every ray.
+                None => (f64::NEG_INFINITY, f64::INFINITY),
+            };
             (lo, hi, 1.0 + 5e-4 / self.step)
         } else {
             let (lo, hi) = angular_span(&self.source, region, buf)?;
             (lo, hi, 0.0)
         };
         let n = self.dirs.len();
-        let a = (((lo - self.lo) / self.step - margin).floor().max(0.0) as usize).min(n);
-        let b = (((hi - self.lo) / self.step + margin).ceil().max(0.0) as usize).min(n);
+        // Non-negative values, so casts truncate as floor would (without
+        // SSE4.1, `floor` is a libm call).
+        let from = ((lo - self.lo) / self.step - margin).clamp(0.0, n as f64);
+        let to = ((hi - self.lo) / self.step + margin).clamp(0.0, n as f64);
+        let a = from as usize;
+        let b = ((to as usize) + usize::from((to as usize as f64) < to)).min(n);
         (a < b).then_some((a, b))
     }
 }
@@ -244,85 +266,91 @@ impl RayHits {
         let mut buf = Vec::new();
         let n = sr.dirs.len();
         let o = sr.source.pos;
-        // Pass 1: which rays each region meets, to size the ray lists.
-        // Regions go track by track (the i-th region of every step in turn):
-        // one sensor's consecutive fields of view overlap on most rays, so
-        // pass 2 merges them as they come and leaves little to sort.
+        // Regions go track by track (the i-th region of every step: one
+        // sensor's fields of view, newest first). Consecutive ones overlap on
+        // most rays, so each ray's intervals from one track are merged as
+        // they come, in a buffer over the track's rays; what is left (about
+        // one interval per ray and track) is sorted by ray afterwards.
         let tracks = observed.iter().map(Vec::len).max().unwrap_or(0);
-        let mut ranges = Vec::new();
-        let mut counts = vec![0u32; n + 1];
+        let mut pieces: Vec<(u32, f64, f64)> = Vec::new();
+        let mut open: Vec<(f64, f64)> = Vec::new();
+        let mut spans = Vec::with_capacity(observed.len());
         for i in 0..tracks {
+            spans.clear();
+            let (mut lo, mut hi) = (n, 0);
             for (s, regions) in observed.iter().enumerate() {
                 let Some(region) = regions.get(i) else {
                     continue;
                 };
                 if let Some((a, b)) = sr.range(region, &mut buf) {
-                    ranges.push((a, b, speed * s as f64, region));
-                    for c in &mut counts[a + 1..=b] {
-                        *c += 1;
+                    spans.push((a, b, speed * s as f64, region));
+                    (lo, hi) = (lo.min(a), hi.max(b));
+                }
+            }
+            if spans.is_empty() {
+                continue;
+            }
+            open.clear();
+            open.resize(hi - lo, EMPTY);
+            for &(a, b, shift, region) in &spans {
+                let open = &mut open[a - lo..b - lo];
+                if region.disk.is_none() {
+                    // Slab test, branch-free (no direction component is 0).
+                    let r = &region.rect;
+                    let (x0, x1, y0, y1) = (r.x0 - o.x, r.x1 - o.x, r.y0 - o.y, r.y1 - o.y);
+                    for (j, (&(_, inv), cur)) in sr.dirs[a..b].iter().zip(open).enumerate() {
+                        let (tx0, tx1) = (x0 * inv.x, x1 * inv.x);
+                        let (ty0, ty1) = (y0 * inv.y, y1 * inv.y);
+                        let p = max(max(min(tx0, tx1), min(ty0, ty1)), 0.0);
+                        let q = min(max(tx0, tx1), max(ty0, ty1));
+                        if p <= q {
+                            extend(cur, (a + j) as u32, p + shift, q + shift, &mut pieces);
+                        }
+                    }
+                } else {
+                    for (j, cur) in open.iter_mut().enumerate() {
+                        let (d, inv) = sr.dirs[a + j];
+                        if let Some((p, q)) = region.ray(o, d, inv) {
+                            extend(cur, (a + j) as u32, p + shift, q + shift, &mut pieces);
+                        }
                     }
                 }
             }
+            for (j, &(p, q)) in open.iter().enumerate() {
+                if p <= q {
+                    pieces.push(((lo + j) as u32, p, q));
+                }
+            }
+        }
+        // By ray (a counting sort), then each ray's few pieces by start,
+        // merged into sorted disjoint intervals.
+        let mut offsets = vec![0u32; n + 1];
+        for &(m, ..) in &pieces {
+            offsets[m as usize + 1] += 1;
         }
         for m in 0..n {
-            counts[m + 1] += counts[m];
+            offsets[m + 1] += offsets[m];
         }
-        // Pass 2: every ray's intervals, into its slot, merged with the
-        // slot's last interval when they overlap.
-        let mut fill = counts.clone();
-        let mut raw = vec![(0.0, 0.0); counts[n] as usize];
-        let mut push = |m: usize, p: f64, q: f64| {
-            let (first, end) = (counts[m] as usize, fill[m] as usize);
-            if end > first {
-                let last = &mut raw[end - 1];
-                if p <= last.1 && q >= last.0 {
-                    *last = (last.0.min(p), last.1.max(q));
-                    return;
-                }
-            }
-            raw[end] = (p, q);
-            fill[m] += 1;
-        };
-        for &(a, b, shift, region) in &ranges {
-            if region.disk.is_none() {
-                // Slab test, branch-free (no direction component is 0).
-                let r = &region.rect;
-                let (x0, x1, y0, y1) = (r.x0 - o.x, r.x1 - o.x, r.y0 - o.y, r.y1 - o.y);
-                for (m, &(_, inv)) in sr.dirs[a..b].iter().enumerate() {
-                    let (tx0, tx1) = (x0 * inv.x, x1 * inv.x);
-                    let (ty0, ty1) = (y0 * inv.y, y1 * inv.y);
-                    let p = tx0.min(tx1).max(ty0.min(ty1)).max(0.0);
-                    let q = tx0.max(tx1).min(ty0.max(ty1));
-                    if p <= q {
-                        push(a + m, p + shift, q + shift);
-                    }
-                }
-            } else {
-                for m in a..b {
-                    let (d, inv) = sr.dirs[m];
-                    if let Some((p, q)) = region.ray(o, d, inv) {
-                        push(m, p + shift, q + shift);
-                    }
-                }
-            }
+        let mut next = offsets.clone();
+        let mut sorted = vec![(0.0, 0.0); pieces.len()];
+        for &(m, p, q) in &pieces {
+            sorted[next[m as usize] as usize] = (p, q);
+            next[m as usize] += 1;
         }
-        // Pass 3: sort and merge each ray's intervals.
-        let mut offsets = Vec::with_capacity(n + 1);
-        let mut hits: Vec<(f64, f64)> = Vec::with_capacity(raw.len() / 2);
-        offsets.push(0);
+        let mut hits: Vec<(f64, f64)> = Vec::with_capacity(sorted.len());
+        let mut start = 0;
         for m in 0..n {
-            let list = &mut raw[counts[m] as usize..fill[m] as usize];
+            let list = &mut sorted[start..offsets[m + 1] as usize];
+            start = offsets[m + 1] as usize;
             list.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
             let first = hits.len();
             for &(p, q) in list.iter() {
-                if hits.len() > first && p <= hits[hits.len() - 1].1 {
-                    let last = hits.len() - 1;
-                    hits[last].1 = hits[last].1.max(q);
-                } else {
-                    hits.push((p, q));
+                match hits[first..].last_mut() {
+                    Some(last) if p <= last.1 => last.1 = last.1.max(q),
+                    _ => hits.push((p, q)),
                 }
             }
-            offsets.push(hits.len() as u32);
+            offsets[m + 1] = hits.len() as u32;
         }
         RayHits { offsets, hits }
     }
@@ -331,6 +359,36 @@ impl RayHits {
     #[inline]
     fn of(&self, m: usize) -> &[(f64, f64)] {
         &self.hits[self.offsets[m] as usize..self.offsets[m + 1] as usize]
+    }
+}
+
+/// The smaller of two numbers that are not NaN (one `minsd`: `f64::min`
+/// also handles NaN, at three instructions, in the hottest loops).
+#[inline(always)]
+fn min(a: f64, b: f64) -> f64 {
+    if a < b { a } else { b }
+}
+
+/// The larger of two numbers that are not NaN.
+#[inline(always)]
+fn max(a: f64, b: f64) -> f64 {
+    if a > b { a } else { b }
+}
+
+/// No interval yet (`p > q`).
+const EMPTY: (f64, f64) = (f64::INFINITY, f64::NEG_INFINITY);
+
+/// Extends `cur`, ray `m`'s interval being merged, by `[p, q]` when they
+/// overlap; otherwise moves `cur` to `pieces` and starts again from `[p, q]`.
+#[inline]
+fn extend(cur: &mut (f64, f64), m: u32, p: f64, q: f64, pieces: &mut Vec<(u32, f64, f64)>) {
+    if p <= cur.1 && q >= cur.0 {
+        *cur = (min(cur.0, p), max(cur.1, q));
+    } else {
+        if cur.0 <= cur.1 {
+            pieces.push((m, cur.0, cur.1));
+        }
+        *cur = (p, q);
     }
 }
 
@@ -485,6 +543,7 @@ impl<'a> ExactEstimator<'a> {
             .par_iter()
             .map(|sr| RayHits::new(sr, observed, scenario.speed))
             .collect();
+
         let grid = grid.filter(|_| matches!(scenario.fov, FovSpec::Square { .. }));
         Self {
             scenario,
@@ -553,82 +612,40 @@ impl<'a> ExactEstimator<'a> {
                 unseen.push(grid.mass(a, a + 1, b, b + 1));
             }
         }
-        let rect = crate::geometry::Rect {
-            x0: grid.xs[a0],
-            y0: grid.ys[b0],
-            x1: grid.xs[a1],
-            y1: grid.ys[b1],
-        };
-        let region = Region { rect, disk: None };
         let lift = s.speed * t as f64;
         let block = (a0, a1, b0, b1);
         let whole = {
             let (nx, ny) = grid.dims();
             block == (0, nx, 0, ny)
         };
-        // Each source accumulates into its own buffer, in parallel.
-        let seen_by_source: Vec<Vec<f64>> = self
+        // The sources split among the threads, each adding into its own
+        // buffer (one per thread, not per source: the buffers are summed).
+        let chunk = self
             .rays
-            .par_iter()
-            .zip(&self.seen)
-            .map(|(sr, seen)| {
+            .len()
+            .div_ceil(rayon::current_num_threads())
+            .max(1);
+        let per_thread: Vec<Vec<f64>> = self
+            .rays
+            .par_chunks(chunk)
+            .zip(self.seen.par_chunks(chunk))
+            .map(|(rays, seen)| {
                 let mut acc = vec![0.0; na * nb];
-                let mut buf = Vec::new();
-                let Some((ma, mb)) = sr.range(&region, &mut buf) else {
-                    return acc;
-                };
-                for m in ma..mb {
-                    let hits = seen.of(m);
-                    if hits.is_empty() {
-                        continue;
-                    }
-                    let (d, inv) = sr.dirs[m];
-                    let Some((wa, wb)) = region.ray(sr.source.pos, d, inv) else {
-                        continue;
-                    };
-                    // The seen union at step t, clipped to the block.
-                    let (wa, wb) = (wa - lift, wb - lift);
-                    let from = hits.partition_point(|&(_, q)| q <= wa);
-                    for &(p, q) in &hits[from..] {
-                        if p >= wb {
-                            break;
-                        }
-                        let (p, q) = (p.max(wa) + lift, q.min(wb) + lift);
-                        if q <= p {
-                            continue;
-                        }
-                        if let Some(cr) = &sr.crossings {
-                            let (rs, cells, lin) = cr.of(m);
-                            let mut k = rs.partition_point(|&x| x <= p).saturating_sub(1);
-                            if whole {
-                                // The block is the grid: no bounds to check.
-                                while k < lin.len() && rs[k] < q {
-                                    acc[lin[k] as usize] += rs[k + 1].min(q) - rs[k].max(p);
-                                    k += 1;
-                                }
-                                continue;
-                            }
-                            while k < cells.len() && rs[k] < q {
-                                let len = rs[k + 1].min(q) - rs[k].max(p);
-                                let [a, b] = cells[k];
-                                let (a, b) = (a as usize, b as usize);
-                                // Rounding at the block's edge: a sliver outside is dropped.
-                                if len > 0.0 && (a0..a1).contains(&a) && (b0..b1).contains(&b) {
-                                    acc[(b - b0) * na + (a - a0)] += len;
-                                }
-                                k += 1;
-                            }
-                        } else {
-                            walk(grid, block, &mut acc, sr.source.pos, d, inv, p, q);
-                        }
-                    }
+                for (sr, seen) in rays.iter().zip(seen) {
+                    self.accumulate(grid, block, whole, lift, sr, seen, &mut acc);
                 }
                 acc
             })
             .collect();
-        for (acc, sr) in seen_by_source.iter().zip(self.rays) {
-            for (u, s) in unseen.iter_mut().zip(acc) {
-                *u -= sr.weight * s;
+        let mut per_thread = per_thread.into_iter();
+        if let Some(first) = per_thread.next() {
+            for (u, s) in unseen.iter_mut().zip(&first) {
+                *u -= s;
+            }
+            for acc in per_thread {
+                for (u, s) in unseen.iter_mut().zip(&acc) {
+                    *u -= s;
+                }
             }
         }
         Window {
@@ -637,6 +654,109 @@ impl<'a> ExactEstimator<'a> {
             na,
             nb,
             unseen,
+        }
+    }
+
+    /// Adds to `acc` what the rays of one source saw in each rectangle of
+    /// `block` at lift `v·t`, times the source's weight.
+    #[allow(clippy::too_many_arguments)]
+    fn accumulate(
+        &self,
+        grid: &ElementaryGrid,
+        block: Block,
+        whole: bool,
+        lift: f64,
+        sr: &SourceRays,
+        seen: &RayHits,
+        acc: &mut [f64],
+    ) {
+        let w = sr.weight;
+        if let (true, Some(cr)) = (whole, &sr.crossings) {
+            // The block is the grid: every ray, no bounds to check.
+            for m in 0..sr.dirs.len() {
+                let (rs, _, lin) = cr.of(m);
+                let hits = seen.of(m);
+                if hits.is_empty() || lin.is_empty() {
+                    continue;
+                }
+                let end = rs[lin.len()] - lift;
+                let from = hits.partition_point(|&(_, q)| q + lift <= rs[0]);
+                let mut k = usize::MAX;
+                for &(p, q) in &hits[from..] {
+                    if p >= end {
+                        break;
+                    }
+                    let (p, q) = (p + lift, q + lift);
+                    k = next_crossing(rs, k, p);
+                    while k < lin.len() && rs[k] < q {
+                        acc[lin[k] as usize] += w * (min(rs[k + 1], q) - max(rs[k], p));
+                        k += 1;
+                    }
+                }
+            }
+            return;
+        }
+        let (a0, a1, b0, b1) = block;
+        let na = a1 - a0;
+        let region = Region {
+            rect: crate::geometry::Rect {
+                x0: grid.xs[a0],
+                y0: grid.ys[b0],
+                x1: grid.xs[a1],
+                y1: grid.ys[b1],
+            },
+            disk: None,
+        };
+        let mut buf = Vec::new();
+        let Some((ma, mb)) = sr.range(&region, &mut buf) else {
+            return;
+        };
+        for m in ma..mb {
+            let hits = seen.of(m);
+            if hits.is_empty() {
+                continue;
+            }
+            let (d, inv) = sr.dirs[m];
+            let Some((wa, wb)) = region.ray(sr.source.pos, d, inv) else {
+                continue;
+            };
+            // The seen union at step t, clipped to the block.
+            let (wa, wb) = (wa - lift, wb - lift);
+            let from = hits.partition_point(|&(_, q)| q <= wa);
+            let Some(cr) = &sr.crossings else {
+                for &(p, q) in &hits[from..] {
+                    if p >= wb {
+                        break;
+                    }
+                    let (p, q) = (max(p, wa) + lift, min(q, wb) + lift);
+                    if q > p {
+                        walk(grid, block, acc, sr.source.pos, d, inv, p, q, w);
+                    }
+                }
+                continue;
+            };
+            let (rs, cells, _) = cr.of(m);
+            let mut k = usize::MAX;
+            for &(p, q) in &hits[from..] {
+                if p >= wb {
+                    break;
+                }
+                let (p, q) = (max(p, wa) + lift, min(q, wb) + lift);
+                if q <= p {
+                    continue;
+                }
+                k = next_crossing(rs, k, p);
+                while k < cells.len() && rs[k] < q {
+                    let len = min(rs[k + 1], q) - max(rs[k], p);
+                    let [a, b] = cells[k];
+                    let (a, b) = (a as usize, b as usize);
+                    // Rounding at the block's edge: a sliver outside is dropped.
+                    if len > 0.0 && (a0..a1).contains(&a) && (b0..b1).contains(&b) {
+                        acc[(b - b0) * na + (a - a0)] += w * len;
+                    }
+                    k += 1;
+                }
+            }
         }
     }
 
@@ -735,8 +855,24 @@ impl<'a> ExactEstimator<'a> {
     }
 }
 
-/// Adds to `acc`, the seen length in each elementary rectangle of `block`,
-/// the ray segment `[r0, r1]`, rectangle by rectangle.
+/// The crossing whose segment holds `p`, for the intervals of one ray in
+/// order: `k` is where the previous interval ended (`usize::MAX` before the
+/// first). The first is found by bisection, the next by scanning on from the
+/// last: the gaps are short, and a scan is cheaper than dependent loads.
+#[inline]
+fn next_crossing(rs: &[f64], k: usize, p: f64) -> usize {
+    if k == usize::MAX {
+        return rs.partition_point(|&x| x <= p).saturating_sub(1);
+    }
+    let mut k = k.saturating_sub(1);
+    while k + 1 < rs.len() && rs[k + 1] <= p {
+        k += 1;
+    }
+    k
+}
+
+/// Adds to `acc`, the seen mass in each elementary rectangle of `block`,
+/// the ray segment `[r0, r1]` times `w`, rectangle by rectangle.
 #[allow(clippy::too_many_arguments)]
 fn walk(
     grid: &ElementaryGrid,
@@ -747,10 +883,11 @@ fn walk(
     inv: Point,
     r0: f64,
     r1: f64,
+    w: f64,
 ) {
     let (a_lo, b_lo, na) = (block.0, block.2, block.1 - block.0);
     trace(grid, block, o, d, inv, r0, r1, |a, b, from, to| {
-        acc[(b - b_lo) * na + (a - a_lo)] += to - from;
+        acc[(b - b_lo) * na + (a - a_lo)] += w * (to - from);
     });
 }
 
@@ -891,7 +1028,52 @@ impl Estimator for ExactEstimator<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::approx_atan2;
+    use super::{SourceRays, approx_atan2};
+    use crate::geometry::{Rect, Region};
+    use crate::scenario::builtins;
+
+    #[test]
+    fn ray_ranges_hold_every_ray_that_meets_a_rectangle() {
+        let s = builtins().remove(0);
+        let rays = SourceRays::for_scenario(&s);
+        let mut buf = Vec::new();
+        // Rectangles on a grid of corners, inside the zone and across its
+        // edges, beside and around the sources (at -1 and 301).
+        let coords = [
+            -40.0, -1.5, -1.0, 0.0, 37.0, 99.0, 100.0, 150.0, 201.0, 299.0, 301.0, 330.0,
+        ];
+        let mut checked = 0;
+        for &x0 in &coords {
+            for &x1 in coords.iter().filter(|&&x| x > x0) {
+                for &y0 in &coords {
+                    for &y1 in coords.iter().filter(|&&y| y > y0) {
+                        let region = Region {
+                            rect: Rect { x0, y0, x1, y1 },
+                            disk: None,
+                        };
+                        for sr in &rays {
+                            let range = sr.range(&region, &mut buf);
+                            for (m, &(d, inv)) in sr.dirs.iter().enumerate() {
+                                let Some((p, q)) = region.ray(sr.source.pos, d, inv) else {
+                                    continue;
+                                };
+                                if q > p {
+                                    checked += 1;
+                                    assert!(
+                                        range.is_some_and(|(a, b)| (a..b).contains(&m)),
+                                        "ray {m} of {:?} meets {:?} outside {range:?}",
+                                        sr.source.pos,
+                                        region.rect
+                                    );
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(checked > 10_000, "{checked}");
+    }
 
     #[test]
     fn approx_atan2_is_within_its_bound() {
