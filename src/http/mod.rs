@@ -2,8 +2,9 @@
 //!
 //! [`router`] builds the whole application from an [`AppState`]; the binary
 //! only binds and serves it. Every error is an [`ApiError`], rendered as
-//! `application/problem+json`. CPU work (precomputing a scenario, planning)
-//! runs on tokio's blocking pool.
+//! `application/problem+json`. CPU work runs off the async workers: plans on
+//! rayon's global pool, at most one per worker at a time ([`on_rayon`]), and
+//! scenario precomputation on a pool of its own ([`precompute`]).
 //!
 //! | Method | Path | Success |
 //! |---|---|---|
@@ -27,7 +28,7 @@ pub mod scenarios;
 
 use std::collections::BTreeMap;
 use std::collections::btree_map::Entry;
-use std::sync::{Arc, PoisonError, RwLock};
+use std::sync::{Arc, OnceLock, PoisonError, RwLock};
 
 use axum::Router;
 use axum::error_handling::HandleErrorLayer;
@@ -54,6 +55,17 @@ pub use error::{ApiError, Problem};
 /// written at full precision.
 pub const MAX_BODY_BYTES: usize = 4 * 1024 * 1024;
 
+/// Work admitted to rayon at once: one piece per worker. With more, the
+/// pieces would interleave on the workers (a worker waiting in a join runs
+/// other jobs meanwhile), so all of them would finish late together, their
+/// working sets evicting each other from cache. The rest wait here in
+/// arrival order (the semaphore is fair), and a request whose client leaves
+/// while waiting is never computed.
+fn work_slots() -> &'static Arc<tokio::sync::Semaphore> {
+    static SLOTS: OnceLock<Arc<tokio::sync::Semaphore>> = OnceLock::new();
+    SLOTS.get_or_init(|| Arc::new(tokio::sync::Semaphore::new(rayon::current_num_threads())))
+}
+
 /// Runs CPU work (a plan) on rayon's global pool and awaits its result:
 /// one hop from the async worker straight to the thread that plans, whose
 /// parallel parts then split without further hand-offs (see
@@ -61,8 +73,15 @@ pub const MAX_BODY_BYTES: usize = 4 * 1024 * 1024;
 pub async fn on_rayon<T: Send + 'static>(
     work: impl FnOnce() -> T + Send + 'static,
 ) -> Result<T, ApiError> {
+    let permit = work_slots()
+        .clone()
+        .acquire_owned()
+        .await
+        .map_err(|_| ApiError::Internal("the work queue is closed".into()))?;
     let (tx, rx) = tokio::sync::oneshot::channel();
     rayon::spawn(move || {
+        // Held until the work ends, even when the client has left.
+        let _permit = permit;
         // A request dropped while queued (client gone, timed out) is not
         // planned: under overload, dead work would otherwise fill the queue
         // and starve the live requests.
@@ -354,5 +373,47 @@ async fn method_not_allowed(method: Method, uri: Uri) -> ApiError {
     ApiError::MethodNotAllowed {
         method: method.to_string(),
         path: uri.path().to_owned(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::time::Duration;
+
+    use super::on_rayon;
+
+    /// Work that splits (as a plan does) must not interleave with other
+    /// work on rayon's workers: at most one piece per worker is running.
+    #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+    async fn work_pieces_run_at_most_one_per_worker() {
+        let running = Arc::new(AtomicUsize::new(0));
+        let most = Arc::new(AtomicUsize::new(0));
+        let tasks: Vec<_> = (0..12)
+            .map(|_| {
+                let (running, most) = (running.clone(), most.clone());
+                tokio::spawn(on_rayon(move || {
+                    let now = running.fetch_add(1, Ordering::SeqCst) + 1;
+                    most.fetch_max(now, Ordering::SeqCst);
+                    // A worker waiting here for the stolen half would run
+                    // other queued jobs meanwhile, were any admitted.
+                    rayon::join(
+                        || std::thread::sleep(Duration::from_millis(5)),
+                        || std::thread::sleep(Duration::from_millis(30)),
+                    );
+                    running.fetch_sub(1, Ordering::SeqCst);
+                }))
+            })
+            .collect();
+        for task in tasks {
+            task.await.expect("joined").expect("ran");
+        }
+        let most = most.load(Ordering::SeqCst);
+        assert!(
+            most <= rayon::current_num_threads(),
+            "{most} pieces ran at once on {} workers",
+            rayon::current_num_threads()
+        );
     }
 }
