@@ -28,6 +28,7 @@ pub mod scenarios;
 
 use std::collections::BTreeMap;
 use std::collections::btree_map::Entry;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, OnceLock, PoisonError, RwLock};
 
 use axum::Router;
@@ -55,29 +56,76 @@ pub use error::{ApiError, Problem};
 /// written at full precision.
 pub const MAX_BODY_BYTES: usize = 4 * 1024 * 1024;
 
+/// Pieces of work that may wait for a rayon worker, per worker; past that,
+/// more are shed at once with 503. Eight plans of the reference workload
+/// are ~5 ms of queue: a burst is absorbed, while under sustained overload
+/// clients hear "retry" at once instead of timing out in a queue that only
+/// grows (and the server would then be planning for clients already gone).
+pub const QUEUE_PER_WORKER: usize = 8;
+
 /// Work admitted to rayon at once: one piece per worker. With more, the
 /// pieces would interleave on the workers (a worker waiting in a join runs
 /// other jobs meanwhile), so all of them would finish late together, their
 /// working sets evicting each other from cache. The rest wait here in
 /// arrival order (the semaphore is fair), and a request whose client leaves
 /// while waiting is never computed.
-fn work_slots() -> &'static Arc<tokio::sync::Semaphore> {
-    static SLOTS: OnceLock<Arc<tokio::sync::Semaphore>> = OnceLock::new();
-    SLOTS.get_or_init(|| Arc::new(tokio::sync::Semaphore::new(rayon::current_num_threads())))
+struct WorkQueue {
+    slots: Arc<tokio::sync::Semaphore>,
+    waiting: AtomicUsize,
+    max_waiting: usize,
+}
+
+fn work_queue() -> &'static WorkQueue {
+    static QUEUE: OnceLock<WorkQueue> = OnceLock::new();
+    QUEUE.get_or_init(|| {
+        let workers = rayon::current_num_threads();
+        WorkQueue {
+            slots: Arc::new(tokio::sync::Semaphore::new(workers)),
+            waiting: AtomicUsize::new(0),
+            max_waiting: QUEUE_PER_WORKER * workers,
+        }
+    })
+}
+
+/// Counts a request as waiting while it exists (a cancelled wait included).
+struct Waiting<'a>(&'a AtomicUsize);
+
+impl Drop for Waiting<'_> {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::Relaxed);
+    }
 }
 
 /// Runs CPU work (a plan) on rayon's global pool and awaits its result:
 /// one hop from the async worker straight to the thread that plans, whose
 /// parallel parts then split without further hand-offs (see
-/// [`Planner::plan`]).
+/// [`Planner::plan`]). At most one piece runs per worker; up to
+/// [`QUEUE_PER_WORKER`] per worker wait, in arrival order.
+///
+/// # Errors
+/// [`ApiError::Overloaded`] when the queue is full, and
+/// [`ApiError::Internal`] if the work panicked.
 pub async fn on_rayon<T: Send + 'static>(
     work: impl FnOnce() -> T + Send + 'static,
 ) -> Result<T, ApiError> {
-    let permit = work_slots()
-        .clone()
-        .acquire_owned()
-        .await
-        .map_err(|_| ApiError::Internal("the work queue is closed".into()))?;
+    let queue = work_queue();
+    let permit = match queue.slots.clone().try_acquire_owned() {
+        Ok(permit) => permit,
+        Err(_) => {
+            if queue.waiting.fetch_add(1, Ordering::Relaxed) >= queue.max_waiting {
+                queue.waiting.fetch_sub(1, Ordering::Relaxed);
+                metrics::counter!("vigil_http_shed_total").increment(1);
+                return Err(ApiError::Overloaded);
+            }
+            let _waiting = Waiting(&queue.waiting);
+            queue
+                .slots
+                .clone()
+                .acquire_owned()
+                .await
+                .map_err(|_| ApiError::Internal("the work queue is closed".into()))?
+        }
+    };
     let (tx, rx) = tokio::sync::oneshot::channel();
     rayon::spawn(move || {
         // Held until the work ends, even when the client has left.
@@ -382,12 +430,63 @@ mod tests {
     use std::sync::atomic::{AtomicUsize, Ordering};
     use std::time::Duration;
 
-    use super::on_rayon;
+    use super::{ApiError, QUEUE_PER_WORKER, on_rayon, work_queue};
+
+    /// The tests here share rayon's pool and the work queue: one at a time.
+    static SERIAL: tokio::sync::Mutex<()> = tokio::sync::Mutex::const_new(());
+
+    #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+    async fn work_past_the_queue_is_shed_at_once() {
+        let _serial = SERIAL.lock().await;
+        let workers = rayon::current_num_threads();
+        let release = Arc::new(AtomicUsize::new(0));
+        let running = Arc::new(AtomicUsize::new(0));
+        let hold = |release: Arc<AtomicUsize>, running: Arc<AtomicUsize>| {
+            move || {
+                running.fetch_add(1, Ordering::SeqCst);
+                while release.load(Ordering::SeqCst) == 0 {
+                    std::thread::sleep(Duration::from_millis(1));
+                }
+            }
+        };
+        let mut tasks = Vec::new();
+        for _ in 0..workers {
+            tasks.push(tokio::spawn(on_rayon(hold(
+                release.clone(),
+                running.clone(),
+            ))));
+        }
+        while running.load(Ordering::SeqCst) < workers {
+            tokio::time::sleep(Duration::from_millis(1)).await;
+        }
+        for _ in 0..QUEUE_PER_WORKER * workers {
+            tasks.push(tokio::spawn(on_rayon(hold(
+                release.clone(),
+                running.clone(),
+            ))));
+        }
+        while work_queue().waiting.load(Ordering::SeqCst) < QUEUE_PER_WORKER * workers {
+            tokio::time::sleep(Duration::from_millis(1)).await;
+        }
+        // The queue is full: the next is shed without waiting.
+        let shed = on_rayon(|| ()).await;
+        assert!(matches!(shed, Err(ApiError::Overloaded)), "{shed:?}");
+        release.store(1, Ordering::SeqCst);
+        for task in tasks {
+            task.await.expect("joined").expect("queued work runs");
+        }
+        assert_eq!(
+            running.load(Ordering::SeqCst),
+            (QUEUE_PER_WORKER + 1) * workers
+        );
+        assert_eq!(work_queue().waiting.load(Ordering::SeqCst), 0);
+    }
 
     /// Work that splits (as a plan does) must not interleave with other
     /// work on rayon's workers: at most one piece per worker is running.
     #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
     async fn work_pieces_run_at_most_one_per_worker() {
+        let _serial = SERIAL.lock().await;
         let running = Arc::new(AtomicUsize::new(0));
         let most = Arc::new(AtomicUsize::new(0));
         let tasks: Vec<_> = (0..12)
