@@ -369,6 +369,92 @@ pub fn inv_r_integral(x0: f64, x1: f64, y0: f64, y1: f64) -> f64 {
     total
 }
 
+/// `∫∫ 1/|p − o| dp` over the part of `rect` inside the wedge of
+/// directions from `o` between `lo` and `hi` (angles counter-clockwise from
+/// the unit vector `frame`, `0 ≤ hi − lo ≤ π`), in closed form.
+///
+/// The rectangle is clipped by the wedge's two half-planes (a convex
+/// polygon), and the polygon is the signed fan of triangles `(o, V_i,
+/// V_i+1)`. Over such a triangle the integral in polar coordinates around
+/// `o` is `∫ ρ(θ) dθ` with `ρ = h/cos(θ − θ_n)` the distance to the edge's
+/// line, i.e. `h·(asinh(u_{i+1}/h) − asinh(u_i/h))` with `h` the distance of
+/// `o` from the line and `u` the positions of the ends along it.
+///
+/// ```
+/// use vigil::geometry::{Point, Rect, inv_r_integral, wedge_inv_r_integral};
+/// let r = Rect { x0: 1.0, y0: -2.0, x1: 4.0, y1: 3.0 };
+/// let o = Point::new(0.0, 0.0);
+/// let east = Point::new(1.0, 0.0);
+/// let half = std::f64::consts::FRAC_PI_2;
+/// // The whole half-plane holds the rectangle: the plain integral.
+/// let whole = wedge_inv_r_integral(o, &r, east, -half, half);
+/// assert!((whole - inv_r_integral(1.0, 4.0, -2.0, 3.0)).abs() < 1e-12);
+/// // Split at the x axis: the two halves add up.
+/// let below = wedge_inv_r_integral(o, &r, east, -half, 0.0);
+/// let above = wedge_inv_r_integral(o, &r, east, 0.0, half);
+/// assert!((below + above - whole).abs() < 1e-12);
+/// ```
+pub fn wedge_inv_r_integral(o: Point, rect: &Rect, frame: Point, lo: f64, hi: f64) -> f64 {
+    if rect.is_empty() || hi <= lo {
+        return 0.0;
+    }
+    let turn = |a: f64| {
+        let (s, c) = a.sin_cos();
+        Point::new(c * frame.x - s * frame.y, c * frame.y + s * frame.x)
+    };
+    let (d_lo, d_hi) = (turn(lo), turn(hi));
+    // Vertices relative to o, counter-clockwise.
+    let mut poly = vec![
+        Point::new(rect.x0 - o.x, rect.y0 - o.y),
+        Point::new(rect.x1 - o.x, rect.y0 - o.y),
+        Point::new(rect.x1 - o.x, rect.y1 - o.y),
+        Point::new(rect.x0 - o.x, rect.y1 - o.y),
+    ];
+    let cross = |a: Point, b: Point| a.x * b.y - a.y * b.x;
+    // Left of d_lo, then right of d_hi.
+    poly = clip_half_plane(&poly, |v| cross(d_lo, v));
+    poly = clip_half_plane(&poly, |v| cross(v, d_hi));
+    let n = poly.len();
+    let mut total = 0.0;
+    for i in 0..n {
+        let (a, b) = (poly[i], poly[(i + 1) % n]);
+        let (ex, ey) = (b.x - a.x, b.y - a.y);
+        let len = ex.hypot(ey);
+        if len == 0.0 {
+            continue;
+        }
+        let (ex, ey) = (ex / len, ey / len);
+        // Signed distance of o from the edge's line (positive: o on the
+        // edge's left, a counter-clockwise triangle o, a, b).
+        let h = a.x * ey - a.y * ex;
+        if h.abs() < 1e-300 {
+            continue;
+        }
+        let (ua, ub) = (a.x * ex + a.y * ey, b.x * ex + b.y * ey);
+        let ha = h.abs();
+        total += h.signum() * ha * ((ub / ha).asinh() - (ua / ha).asinh());
+    }
+    total.max(0.0)
+}
+
+/// The part of a convex polygon where `side(v) ≥ 0` (Sutherland–Hodgman
+/// against one half-plane).
+fn clip_half_plane(poly: &[Point], side: impl Fn(Point) -> f64) -> Vec<Point> {
+    let mut out = Vec::with_capacity(poly.len() + 1);
+    for i in 0..poly.len() {
+        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+        let (sa, sb) = (side(a), side(b));
+        if sa >= 0.0 {
+            out.push(a);
+        }
+        if (sa >= 0.0) != (sb >= 0.0) {
+            let t = sa / (sa - sb);
+            out.push(Point::new(a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)));
+        }
+    }
+    out
+}
+
 static GL: LazyLock<Vec<(Vec<f64>, Vec<f64>)>> =
     LazyLock::new(|| (0..=32).map(compute_gauss_legendre).collect());
 

@@ -2,25 +2,31 @@
 //! scenario is registered.
 //!
 //! For a cell `c` with clipped field of view `F_c` and a source `j` at `s_j`
-//! with rate `λ_j`, a target's takeoff angle `α` is uniform on the π-wide
-//! half-plane, so:
-//! - `θ_cj`, the span of angles whose rays cross `F_c`, gives the entry rate
-//!   `λ_cj = λ_j·θ_cj/π` and `lambda_hat = Σ_j λ_cj` (step 1a);
-//! - a target on a ray crossing `F_c` over the distance interval `[a(α), b(α)]`
-//!   stays `(b−a)/v` steps, so the expected stay over entering targets is
-//!   `escape_time = Σ_j λ_j/(πv)·∫(b−a)dα / lambda_hat` (step 1b);
+//! with rate `λ_j`, a target's takeoff angle `α` is uniform over the
+//! source's cone of width `spread_j` (π for the paper's half-planes), so:
+//! - `θ_cj`, the span of the cone's angles whose rays cross `F_c`, gives the
+//!   entry rate `λ_cj = λ_j·θ_cj/spread_j` and `lambda_hat = Σ_j λ_cj`
+//!   (step 1a); it does not depend on the targets' speeds;
+//! - a target of speed `v` on a ray crossing `F_c` over the distance
+//!   interval `[a(α), b(α)]` stays `(b−a)/v` steps, so over the target
+//!   classes `c` (source × speed, rate `λ_c = λ_j·w_c`) the expected stay of
+//!   an entering target is `escape_time = Σ_c λ_c/(spread_j v_c)·∫(b−a)dα /
+//!   lambda_hat`: the classes' escape times weighted by their entry rates
+//!   (step 1b);
 //! - `d_hat = lambda_hat·escape_time = ∫_{F_c} ρ` with the stationary density
-//!   `ρ_j(p) = λ_j/(π v |p − s_j|)` (step 1c). For square fields of view the
-//!   integral of `1/r` over a rectangle has a closed form; circles use
-//!   Gauss–Legendre quadrature between the angular breakpoints.
+//!   `ρ(p) = Σ_c λ_c/(spread_j v_c |p − s_j|)` inside each cone (step 1c).
+//!   For square fields of view the integral of `1/r` over a rectangle has a
+//!   closed form (cut at the cone's edges when the cone does not hold the
+//!   whole zone: [`wedge_inv_r_integral`]); circles use Gauss–Legendre
+//!   quadrature between the angular breakpoints.
 //!
-//! The per-source escape-time distribution (step 1d), which only the paper
+//! The per-class escape-time distribution (step 1d), which only the paper
 //! estimator reads and only at a sensor's own cell, is evaluated on demand by
 //! [`paper_statistical_part`] rather than stored for every cell.
 
 use rayon::prelude::*;
 
-use crate::geometry::{Point, Region, gauss_legendre, inv_r_integral};
+use crate::geometry::{Point, Region, gauss_legendre, inv_r_integral, wedge_inv_r_integral};
 use crate::scenario::{MAX_HORIZON, Scenario, Source};
 
 /// The statistics of every cell, row-major (`row·cols + col`).
@@ -36,7 +42,7 @@ pub struct Stats {
     pub expected_targets_in_zone: f64,
 }
 
-/// Angular span `[lo, hi]` (takeoff angles relative to the heading) of the
+/// Angular span `[lo, hi]` (takeoff angles of the source's cone) of the
 /// rays from `source` that meet `region`, or `None` when it is degenerate.
 pub fn angular_span(source: &Source, region: &Region, buf: &mut Vec<Point>) -> Option<(f64, f64)> {
     buf.clear();
@@ -48,14 +54,14 @@ pub fn angular_span(source: &Source, region: &Region, buf: &mut Vec<Point>) -> O
         lo = lo.min(a);
         hi = hi.max(a);
     }
-    // The zone lies in the takeoff half-plane, so the span never wraps.
-    let lo = lo.max(-std::f64::consts::FRAC_PI_2);
-    let hi = hi.min(std::f64::consts::FRAC_PI_2);
-    (hi > lo).then_some((lo, hi))
+    // The source's frame sees the zone without wrap-around, so the span is
+    // an interval; the cone cuts it.
+    source.clip(lo, hi)
 }
 
-/// `∫ (b(α) − a(α)) dα` over the takeoff angles of `source`, where `[a, b]`
-/// is the ray's interval in `region`; equals `∫∫_region 1/|p − s| dp`.
+/// `∫ (b(α) − a(α)) dα` over the takeoff angles of `source`'s cone, where
+/// `[a, b]` is the ray's interval in `region`; equals `∫∫ 1/|p − s| dp` over
+/// the part of `region` inside the cone.
 pub fn chord_integral(source: &Source, region: &Region, buf: &mut Vec<Point>) -> f64 {
     if region.rect.is_empty() {
         return 0.0;
@@ -63,11 +69,30 @@ pub fn chord_integral(source: &Source, region: &Region, buf: &mut Vec<Point>) ->
     if region.disk.is_none() {
         let r = &region.rect;
         let s = source.pos;
-        return inv_r_integral(r.x0 - s.x, r.x1 - s.x, r.y0 - s.y, r.y1 - s.y);
+        if source.covers_zone {
+            return inv_r_integral(r.x0 - s.x, r.x1 - s.x, r.y0 - s.y, r.y1 - s.y);
+        }
+        return wedge_inv_r_integral(s, r, source.frame, source.cone.0, source.cone.1);
     }
     buf.clear();
     region.breakpoints(source.pos, buf);
     let mut angles: Vec<f64> = buf.iter().map(|&p| source.angle_to(p)).collect();
+    if !source.covers_zone {
+        // The cone's edges are kinks too; outside it nothing is emitted.
+        let (lo, hi) = angles
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &a| {
+                (l.min(a), h.max(a))
+            });
+        for a in angles.iter_mut() {
+            *a = a.clamp(source.cone.0.max(lo), source.cone.1.min(hi));
+        }
+        angles.extend(
+            [source.cone.0, source.cone.1]
+                .into_iter()
+                .filter(|&a| a > lo && a < hi),
+        );
+    }
     angles.sort_by(f64::total_cmp);
     let (nodes, weights) = gauss_legendre(16);
     let mut total = 0.0;
@@ -97,14 +122,16 @@ impl Stats {
                 let region = s.fov_region(s.cell_at(i));
                 let mut lambda_hat = 0.0;
                 let mut d_hat = 0.0;
-                for src in &s.sources {
+                for (j, src) in s.sources.iter().enumerate() {
                     if src.rate == 0.0 {
                         continue;
                     }
                     if let Some((lo, hi)) = angular_span(src, &region, buf) {
-                        lambda_hat += src.rate * (hi - lo) / std::f64::consts::PI;
-                        d_hat += src.rate * chord_integral(src, &region, buf)
-                            / (std::f64::consts::PI * s.speed);
+                        lambda_hat += src.rate * (hi - lo) / src.spread;
+                        let chord = chord_integral(src, &region, buf);
+                        for class in s.classes_of(j) {
+                            d_hat += class.rate * chord / (src.spread * class.speed);
+                        }
                     }
                 }
                 (lambda_hat, d_hat)
@@ -115,8 +142,12 @@ impl Stats {
         let expected_targets_in_zone = s
             .sources
             .iter()
-            .map(|src| {
-                src.rate * chord_integral(src, &zone, &mut buf) / (std::f64::consts::PI * s.speed)
+            .enumerate()
+            .flat_map(|(j, src)| {
+                let chord = chord_integral(src, &zone, &mut buf);
+                s.classes_of(j)
+                    .iter()
+                    .map(move |class| class.rate * chord / (src.spread * class.speed))
             })
             .sum();
         let (lambda_hat, d_hat): (Vec<f64>, Vec<f64>) = per_cell.into_iter().unzip();
@@ -139,49 +170,57 @@ const ESCAPE_SAMPLES: usize = 512;
 
 /// The statistical part of the paper's equation (1) at a sensor's own cell
 /// `Pi`, for every horizon: element `t` (1 ≤ t ≤ 12) is
-/// `λ̂_Pi·t − Σ_j λ̂_Pi,j Σ_{u=1..t} P(te_Pi,j < t − u)`, the expected number of
-/// targets that enter `F_Pi` during the next `t` steps and are still inside at
-/// step `t`. Element 0 is 0.
+/// `λ̂_Pi·t − Σ_c λ̂_Pi,c Σ_{u=1..t} P(te_Pi,c < t − u)`, the expected number
+/// of targets that enter `F_Pi` during the next `t` steps and are still
+/// inside at step `t`. Element 0 is 0.
 ///
-/// `te_Pi,j` is the escape time of a target from source `j` whose takeoff
-/// angle is uniform over the span `θ_Pi,j`; its distribution (the paper's
-/// `f(te)/η`) is sampled at 512 evenly spaced angles of the span.
+/// The paper's sum over sources `j` is read as a sum over target classes
+/// `c` (source × speed): `λ̂_Pi,c = λ_j·w_c·θ_Pi,j/spread_j` is the class's
+/// entry rate (they add up to `λ̂_Pi`), and `te_Pi,c` its escape time, the
+/// chord of `F_Pi` over the class's speed for a takeoff angle uniform over
+/// the span `θ_Pi,j` (the paper's `f(te)/η`, per class), sampled at 512
+/// evenly spaced angles of the span.
 pub fn paper_statistical_part(s: &Scenario, region: &Region) -> [f64; MAX_HORIZON + 1] {
     let mut out = [0.0; MAX_HORIZON + 1];
     let mut buf = Vec::new();
-    for src in &s.sources {
+    let mut chords = Vec::with_capacity(ESCAPE_SAMPLES);
+    for (j, src) in s.sources.iter().enumerate() {
         let Some((lo, hi)) = angular_span(src, region, &mut buf) else {
             continue;
         };
-        let lambda_j = src.rate * (hi - lo) / std::f64::consts::PI;
-        if lambda_j == 0.0 {
-            continue;
-        }
-        // still[u] = P(te ≥ u) for u = 0..MAX_HORIZON.
-        let mut still = [0.0f64; MAX_HORIZON + 1];
+        chords.clear();
         let step = (hi - lo) / ESCAPE_SAMPLES as f64;
         for m in 0..ESCAPE_SAMPLES {
             let d = src.direction(lo + (m as f64 + 0.5) * step);
             let inv = Point::new(1.0 / d.x, 1.0 / d.y);
-            let te = region
-                .ray(src.pos, d, inv)
-                .map_or(0.0, |(a, b)| (b - a) / s.speed);
-            for (u, slot) in still.iter_mut().enumerate() {
-                if te >= u as f64 {
-                    *slot += 1.0;
+            chords.push(region.ray(src.pos, d, inv).map_or(0.0, |(a, b)| b - a));
+        }
+        for class in s.classes_of(j) {
+            let lambda_c = class.rate * (hi - lo) / src.spread;
+            if lambda_c == 0.0 {
+                continue;
+            }
+            // still[u] = P(te ≥ u) for u = 0..MAX_HORIZON.
+            let mut still = [0.0f64; MAX_HORIZON + 1];
+            for &chord in &chords {
+                let te = chord / class.speed;
+                for (u, slot) in still.iter_mut().enumerate() {
+                    if te >= u as f64 {
+                        *slot += 1.0;
+                    }
                 }
             }
-        }
-        // Σ_{u=1..t} P(te ≥ t − u) = Σ_{τ=0..t−1} P(te ≥ τ); P(te ≥ 0) = 1.
-        let mut acc = 0.0;
-        for t in 1..=MAX_HORIZON {
-            let p = if t == 1 {
-                1.0
-            } else {
-                still[t - 1] / ESCAPE_SAMPLES as f64
-            };
-            acc += p;
-            out[t] += lambda_j * acc;
+            // Σ_{u=1..t} P(te ≥ t − u) = Σ_{τ=0..t−1} P(te ≥ τ); P(te ≥ 0) = 1.
+            let mut acc = 0.0;
+            for t in 1..=MAX_HORIZON {
+                let p = if t == 1 {
+                    1.0
+                } else {
+                    still[t - 1] / ESCAPE_SAMPLES as f64
+                };
+                acc += p;
+                out[t] += lambda_c * acc;
+            }
         }
     }
     out

@@ -1,8 +1,9 @@
 //! A simulation of the target process itself, independent of the estimators:
 //! each source emits targets as a Poisson process in continuous time with a
-//! uniform takeoff angle over its half-plane; targets fly straight at the
-//! scenario's speed, exist while inside the closed zone, and are gone once
-//! they leave it.
+//! uniform takeoff angle over its cone (a half-plane for the paper's
+//! sources) and a speed drawn once from its speed distribution; targets fly
+//! straight, exist while inside the closed zone, and are gone once they
+//! leave it.
 //!
 //! Used by the Monte Carlo checks of the statistics and the estimators, and
 //! by the simulation client.
@@ -69,7 +70,12 @@ impl World {
     pub fn stationary(s: &Scenario, rng: &mut impl rand::Rng) -> Self {
         let mut w = World::empty(s);
         for j in 0..s.sources.len() {
-            let window = w.reach[j] / s.speed;
+            let slowest = s
+                .classes_of(j)
+                .iter()
+                .map(|c| c.speed)
+                .fold(f64::INFINITY, f64::min);
+            let window = w.reach[j] / slowest;
             w.emit(s, j, window, rng);
         }
         w
@@ -87,16 +93,33 @@ impl World {
             Ok(p) => p.sample(rng) as u64,
             Err(_) => 0,
         };
+        let classes = s.classes_of(j);
+        let centre = 0.5 * (src.cone.0 + src.cone.1);
         for _ in 0..count {
             let age = rng.random::<f64>() * window;
-            let alpha = (rng.random::<f64>() - 0.5) * std::f64::consts::PI;
+            let alpha = centre + (rng.random::<f64>() - 0.5) * src.spread;
+            let speed = if classes.len() == 1 {
+                classes[0].speed
+            } else {
+                // A class with probability rate_c / rate (its weight).
+                let mut x = rng.random::<f64>() * src.rate;
+                let mut speed = classes[classes.len() - 1].speed;
+                for c in classes {
+                    if x < c.rate {
+                        speed = c.speed;
+                        break;
+                    }
+                    x -= c.rate;
+                }
+                speed
+            };
             let u = src.direction(alpha);
-            let dist = s.speed * age;
+            let dist = speed * age;
             let pos = Point::new(src.pos.x + u.x * dist, src.pos.y + u.y * dist);
             let mut t = SimTarget {
                 id: self.next_id,
                 pos,
-                vel: Point::new(u.x * s.speed, u.y * s.speed),
+                vel: Point::new(u.x * speed, u.y * speed),
                 entered: false,
                 source: j,
             };

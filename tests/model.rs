@@ -9,10 +9,15 @@
 use rand::{SeedableRng, rngs::StdRng};
 use rayon::prelude::*;
 use vigil::coordination::Coordination;
-use vigil::estimator::{ElementaryGrid, Estimator, ExactEstimator, SourceRays, Target};
+use vigil::estimator::{
+    ElementaryGrid, Estimator, ExactEstimator, RAYS_PER_PI_SQUARE, SourceRays, Target,
+};
 use vigil::geometry::{Point, Region};
 use vigil::planner::{EstimatorKind, Id, PlanRequest, Planner, SensorIn, TargetIn};
-use vigil::scenario::{Cell, FovSpec, Scenario, builtins, paper_spec};
+use vigil::scenario::{
+    Cell, FovSpec, Heading, Scenario, ScenarioSpec, SourceSpec, SpeedSpec, ZoneSpec, builtins,
+    paper_spec,
+};
 use vigil::stats::Stats;
 use vigil::world::World;
 
@@ -140,9 +145,20 @@ struct Experiment {
 }
 
 fn run_unbiasedness(s: &Scenario, reporting: Reporting, worlds: usize) -> Experiment {
-    let stats = Stats::compute(s);
-    let rays = SourceRays::for_scenario(s);
-    let grid = ElementaryGrid::new(s);
+    run_unbiasedness_with(s, s, reporting, worlds)
+}
+
+/// The unbiasedness experiment with the targets drawn from `s` and the
+/// estimator built for `model` (the same zone): a wrong model must show.
+fn run_unbiasedness_with(
+    s: &Scenario,
+    model: &Scenario,
+    reporting: Reporting,
+    worlds: usize,
+) -> Experiment {
+    let stats = Stats::compute(model);
+    let rays = SourceRays::for_scenario(model);
+    let grid = ElementaryGrid::new(model);
     let sensors = [(9, 9), (12, 10), (21, 19)].map(|(col, row)| Cell { col, row });
     let (steps, moving, pass_history) = match reporting {
         Reporting::NowOnly => (0, false, false),
@@ -203,7 +219,7 @@ fn run_unbiasedness(s: &Scenario, reporting: Reporting, worlds: usize) -> Experi
                 .map(|s_ago| at(s_ago).iter().map(|&c| s.fov_region(c)).collect())
                 .collect();
             let est = ExactEstimator::new(
-                s,
+                model,
                 &stats,
                 &rays,
                 grid.as_ref(),
@@ -480,12 +496,26 @@ fn fast_and_general_exact_paths_agree() {
     use rand::RngExt;
     let mut spec = paper_spec(13.0);
     spec.fov = FovSpec::Square { half_width: 27.0 };
-    let scenarios = [builtins().remove(0), Scenario::new(spec).unwrap()];
+    let scenarios = [
+        builtins().remove(0),
+        Scenario::new(spec).unwrap(),
+        Scenario::new(mixture_spec(FovSpec::Square { half_width: 30.0 })).unwrap(),
+        builtins().remove(2),
+    ];
     for s in &scenarios {
         let stats = Stats::compute(s);
         let grid = ElementaryGrid::new(s);
-        // Without and with the index of crossings: grid walk and merge.
-        let plain = SourceRays::for_scenario(s);
+        // Without and with the index of crossings: grid walk and merge. The
+        // general path's midpoint-rule error on excluded areas grows with
+        // the targets' density along a ray (slow classes, narrow cones), so
+        // the rays are denser by the same factor over the paper's.
+        let paper_density = 0.3 / (std::f64::consts::PI * 10.0);
+        let density = s
+            .classes
+            .iter()
+            .map(|c| c.density(&s.sources[c.source]) / paper_density)
+            .fold(1.0, f64::max);
+        let plain = SourceRays::with_density(s, RAYS_PER_PI_SQUARE * density.ceil());
         let mut indexed = plain.clone();
         SourceRays::index_crossings(&mut indexed, s, grid.as_ref().unwrap());
         let mut rng = StdRng::seed_from_u64(11);
@@ -577,4 +607,305 @@ fn fast_and_general_exact_paths_agree() {
         }
         assert!(worst > 0.0, "the exclusions were exercised");
     }
+}
+
+// Targets as they really come: speed mixtures and directed cones.
+
+/// A 300×300 zone (10-unit cells, the paper's lattice) with four sources:
+/// cones of 60°, 40°, 120° (around a heading) and 30°, and one to three
+/// speed classes each.
+fn mixture_spec(fov: FovSpec) -> ScenarioSpec {
+    let class = |speed: f64, weight: f64| SpeedSpec { speed, weight };
+    ScenarioSpec {
+        name: Some("mixture".into()),
+        zone: ZoneSpec {
+            width: 300.0,
+            height: 300.0,
+        },
+        cell_size: 10.0,
+        fov,
+        target_speed: Some(8.0),
+        sources: vec![
+            SourceSpec {
+                direction: Some(10.0),
+                spread: Some(60.0),
+                speeds: Some(vec![class(4.0, 1.0), class(12.0, 1.0)]),
+                ..SourceSpec::at(-1.0, 150.0, 0.5)
+            },
+            SourceSpec {
+                direction: Some(80.0),
+                spread: Some(40.0),
+                speeds: Some(vec![class(3.0, 2.0), class(9.0, 1.0), class(15.0, 1.0)]),
+                ..SourceSpec::at(150.0, -1.0, 0.4)
+            },
+            SourceSpec {
+                heading: Some(Heading::West),
+                spread: Some(120.0),
+                ..SourceSpec::at(301.0, 250.0, 0.3)
+            },
+            SourceSpec {
+                direction: Some(-45.0),
+                spread: Some(30.0),
+                speeds: Some(vec![class(6.0, 1.0), class(10.0, 3.0)]),
+                ..SourceSpec::at(-20.0, 320.0, 0.3)
+            },
+        ],
+        horizon: Some(3),
+    }
+}
+
+/// A source's cone (centre and width, radians) and its speed classes
+/// `(speed, probability)`, read from the spec alone.
+fn spec_cone_and_speeds(spec: &ScenarioSpec, src: &SourceSpec) -> (f64, f64, Vec<(f64, f64)>) {
+    let centre = src.direction.unwrap_or_else(|| match src.heading {
+        Some(Heading::East) => 0.0,
+        Some(Heading::North) => 90.0,
+        Some(Heading::West) => 180.0,
+        Some(Heading::South) => 270.0,
+        None => panic!("test specs give a heading or a direction"),
+    });
+    let spread = src.spread.unwrap_or(180.0);
+    let speeds = match &src.speeds {
+        Some(v) => {
+            let total: f64 = v.iter().map(|c| c.weight).sum();
+            v.iter().map(|c| (c.speed, c.weight / total)).collect()
+        }
+        None => vec![(spec.target_speed.unwrap(), 1.0)],
+    };
+    (centre.to_radians(), spread.to_radians(), speeds)
+}
+
+/// Positions of the targets of a stationary world, drawn from the spec by
+/// code of its own: per source, emissions over a window long enough for the
+/// slowest target to have crossed the zone, each with a uniform age, a
+/// uniform angle over the cone and a speed drawn by weight.
+fn stationary_positions(spec: &ScenarioSpec, rng: &mut StdRng) -> Vec<Point> {
+    use rand::RngExt;
+    use rand_distr::{Distribution, Poisson};
+    let (w, h) = (spec.zone.width, spec.zone.height);
+    let mut out = Vec::new();
+    for src in &spec.sources {
+        let (centre, spread, speeds) = spec_cone_and_speeds(spec, src);
+        let reach = [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)]
+            .iter()
+            .map(|&(x, y)| (x - src.x).hypot(y - src.y))
+            .fold(0.0, f64::max);
+        let slowest = speeds.iter().map(|c| c.0).fold(f64::INFINITY, f64::min);
+        let window = reach / slowest;
+        let count = Poisson::new(src.rate * window).unwrap().sample(rng) as usize;
+        for _ in 0..count {
+            let age = rng.random::<f64>() * window;
+            let angle = centre + (rng.random::<f64>() - 0.5) * spread;
+            let mut u = rng.random::<f64>();
+            let mut speed = speeds[speeds.len() - 1].0;
+            for &(v, p) in &speeds {
+                if u < p {
+                    speed = v;
+                    break;
+                }
+                u -= p;
+            }
+            let r = speed * age;
+            let p = Point::new(src.x + r * angle.cos(), src.y + r * angle.sin());
+            if (0.0..=w).contains(&p.x) && (0.0..=h).contains(&p.y) {
+                out.push(p);
+            }
+        }
+    }
+    out
+}
+
+/// `d_hat` and `expected_targets_in_zone` of scenarios with speed mixtures
+/// and cones (square and circular fields of view) match the stationary
+/// counts of a Monte Carlo drawn from the spec, within 1% plus three
+/// standard errors.
+#[test]
+fn mixture_d_hat_matches_monte_carlo() {
+    for fov in [
+        FovSpec::Square { half_width: 30.0 },
+        FovSpec::Circle { radius: 35.0 },
+    ] {
+        let spec = mixture_spec(fov);
+        let s = Scenario::new(spec.clone()).unwrap();
+        let stats = Stats::compute(&s);
+        let cells = [
+            (0, 0),
+            (3, 15),
+            (15, 15),
+            (29, 8),
+            (10, 27),
+            (25, 25),
+            (5, 4),
+        ]
+        .map(|(col, row)| Cell { col, row });
+        let regions: Vec<Region> = cells.iter().map(|&c| s.fov_region(c)).collect();
+        let worlds = 20_000;
+        let counts: Vec<Vec<f64>> = (0..worlds)
+            .into_par_iter()
+            .map(|i| {
+                let mut rng = StdRng::seed_from_u64(7_000_000 + i as u64);
+                let targets = stationary_positions(&spec, &mut rng);
+                let mut out: Vec<f64> = regions
+                    .iter()
+                    .map(|r| targets.iter().filter(|&&p| r.contains(p)).count() as f64)
+                    .collect();
+                out.push(targets.len() as f64);
+                out
+            })
+            .collect();
+        let mut expected: Vec<f64> = cells.iter().map(|&c| stats.d_hat[s.index(c)]).collect();
+        expected.push(stats.expected_targets_in_zone);
+        let mut failed = Vec::new();
+        for (j, &e) in expected.iter().enumerate() {
+            let col: Vec<f64> = counts.iter().map(|c| c[j]).collect();
+            let (m, se) = mean_se(&col);
+            let line = format!("{fov:?}: quantity {j}: Monte Carlo {m:.4} ± {se:.4}, model {e:.4}");
+            eprintln!("{line}");
+            if (m - e).abs() > 0.01 * e + 3.0 * se {
+                failed.push(line);
+            }
+        }
+        assert!(failed.is_empty(), "{failed:#?}");
+        // Some cells lie outside every cone, some inside: both were tested.
+        assert!(expected.iter().any(|&e| e > 1.0));
+    }
+}
+
+/// `lambda_hat` with cones: takeoff angles drawn over each spec's cone,
+/// each path tested against the field of view's corners.
+#[test]
+fn mixture_lambda_hat_matches_monte_carlo() {
+    use rand::RngExt;
+    let spec = mixture_spec(FovSpec::Square { half_width: 30.0 });
+    let s = Scenario::new(spec.clone()).unwrap();
+    let stats = Stats::compute(&s);
+    let mut rng = StdRng::seed_from_u64(17);
+    let draws = 200_000;
+    for (col, row) in [(0, 0), (15, 15), (29, 8), (4, 22), (20, 3), (27, 27)] {
+        let c = Cell { col, row };
+        let r = s.fov_region(c).rect;
+        let corners = [(r.x0, r.y0), (r.x1, r.y0), (r.x1, r.y1), (r.x0, r.y1)];
+        let mut rate = 0.0;
+        let mut var = 0.0;
+        for src in &spec.sources {
+            let (centre, spread, _) = spec_cone_and_speeds(&spec, src);
+            let mut hits = 0u32;
+            for _ in 0..draws {
+                let a = centre + (rng.random::<f64>() - 0.5) * spread;
+                let u = (a.cos(), a.sin());
+                let side = |&(x, y): &(f64, f64)| u.0 * (y - src.y) - u.1 * (x - src.x);
+                let ahead = corners
+                    .iter()
+                    .any(|&(x, y)| u.0 * (x - src.x) + u.1 * (y - src.y) > 0.0);
+                let pos = corners.iter().any(|c| side(c) >= 0.0);
+                let neg = corners.iter().any(|c| side(c) <= 0.0);
+                if ahead && pos && neg {
+                    hits += 1;
+                }
+            }
+            let p = hits as f64 / draws as f64;
+            rate += src.rate * p;
+            var += src.rate.powi(2) * p * (1.0 - p) / draws as f64;
+        }
+        let e = stats.lambda_hat[s.index(c)];
+        assert!(
+            (rate - e).abs() <= 0.01 * e + 3.0 * var.sqrt() + 1e-12,
+            "cell {c:?}: Monte Carlo {rate:.5}, lambda_hat {e:.5}"
+        );
+        let esc = stats.escape_time[s.index(c)];
+        assert!((esc * e - stats.d_hat[s.index(c)]).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn exact_estimator_is_unbiased_with_speed_mixtures_and_cones() {
+    let s = Scenario::new(mixture_spec(FovSpec::Square { half_width: 30.0 })).unwrap();
+    assert_unbiased(
+        &run_unbiasedness(&s, Reporting::NowOnly, 12_000),
+        "mixture, no history",
+    );
+    assert_unbiased(
+        &run_unbiasedness(
+            &s,
+            Reporting::WithHistory {
+                steps: 4,
+                moving: false,
+            },
+            12_000,
+        ),
+        "mixture, fixed sensors, 4 steps of history",
+    );
+    assert_unbiased(
+        &run_unbiasedness(
+            &s,
+            Reporting::WithHistory {
+                steps: 3,
+                moving: true,
+            },
+            12_000,
+        ),
+        "mixture, moving sensors, 3 steps of history",
+    );
+    let c = Scenario::new(mixture_spec(FovSpec::Circle { radius: 35.0 })).unwrap();
+    assert_unbiased(
+        &run_unbiasedness(
+            &c,
+            Reporting::WithHistory {
+                steps: 2,
+                moving: true,
+            },
+            12_000,
+        ),
+        "mixture, circles, moving sensors, 2 steps of history",
+    );
+}
+
+/// The check has power against a wrong speed distribution: the sources'
+/// mixtures replaced by single speeds with the same stationary density
+/// (the harmonic mean, so `d_hat` is unchanged) backtrack what was seen by
+/// the wrong distances, and the test sees it.
+#[test]
+fn a_wrong_speed_distribution_is_detected_as_biased() {
+    let truth = mixture_spec(FovSpec::Square { half_width: 30.0 });
+    let mut wrong = truth.clone();
+    for src in &mut wrong.sources {
+        if let Some(speeds) = src.speeds.take() {
+            let total: f64 = speeds.iter().map(|c| c.weight).sum();
+            let inv: f64 = speeds.iter().map(|c| c.weight / total / c.speed).sum();
+            src.speeds = Some(vec![SpeedSpec {
+                speed: 1.0 / inv,
+                weight: 1.0,
+            }]);
+        }
+    }
+    let (truth, wrong) = (Scenario::new(truth).unwrap(), Scenario::new(wrong).unwrap());
+    // The same stationary counts: only the dynamics differ.
+    let (a, b) = (Stats::compute(&truth), Stats::compute(&wrong));
+    for (x, y) in a.d_hat.iter().zip(&b.d_hat) {
+        assert!((x - y).abs() < 1e-9 * x.max(1.0));
+    }
+    let e = run_unbiasedness_with(
+        &truth,
+        &wrong,
+        Reporting::WithHistory {
+            steps: 4,
+            moving: true,
+        },
+        6_000,
+    );
+    let worst = e
+        .results
+        .iter()
+        .map(|&(_, m, se)| (m / se).abs())
+        .fold(0.0, f64::max);
+    for &((k, t), m, se) in &e.results {
+        eprintln!(
+            "wrong speeds: cell ({},{}) t={t}: {m:+.4} ± {se:.4}",
+            k.col, k.row
+        );
+    }
+    assert!(
+        worst > 6.0,
+        "the wrong speeds went unnoticed (largest |z| = {worst:.1})"
+    );
 }

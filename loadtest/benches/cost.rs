@@ -120,8 +120,8 @@ fn targets(c: &mut Criterion) {
                         id: None,
                         x: s.width * (0.5 + 0.49 * f.sqrt() * a.cos()),
                         y: s.height * (0.5 + 0.49 * f.sqrt() * a.sin()),
-                        vx: s.speed * a.sin(),
-                        vy: -s.speed * a.cos(),
+                        vx: s.max_speed() * a.sin(),
+                        vy: -s.max_speed() * a.cos(),
                     });
                     k += 1;
                 }
@@ -154,12 +154,7 @@ fn history(c: &mut Criterion) {
 /// on the edges, square fields of view of 6 × 6 cells.
 pub fn lattice(side: usize) -> Scenario {
     let w = side as f64 * 10.0;
-    let src = |x: f64, y: f64| SourceSpec {
-        x,
-        y,
-        rate: 0.3,
-        heading: None,
-    };
+    let src = |x: f64, y: f64| SourceSpec::at(x, y, 0.3);
     Scenario::new(ScenarioSpec {
         name: Some(format!("{side}×{side}")),
         zone: ZoneSpec {
@@ -168,7 +163,7 @@ pub fn lattice(side: usize) -> Scenario {
         },
         cell_size: 10.0,
         fov: FovSpec::Square { half_width: 30.0 },
-        target_speed: 10.0,
+        target_speed: Some(10.0),
         sources: vec![
             src(-1.0, w / 3.0),
             src(-1.0, 2.0 * w / 3.0),

@@ -26,10 +26,10 @@ pub enum Start {
     Random,
 }
 
-/// Steps a target needs to cross the zone's diagonal: the default warm-up,
-/// after which the zone holds its stationary population.
+/// Steps the slowest target needs to cross the zone's diagonal: the default
+/// warm-up, after which the zone holds its stationary population.
 pub fn default_warmup(s: &Scenario) -> usize {
-    (s.width.hypot(s.height) / s.speed).ceil() as usize
+    (s.width.hypot(s.height) / s.min_speed()).ceil() as usize
 }
 
 /// Near-square grid positions for `n` sensors: `cols = ⌈√n⌉` columns and

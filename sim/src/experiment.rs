@@ -106,8 +106,9 @@ pub struct Row {
     pub scenario: String,
     /// Number of sensors.
     pub sensors: usize,
-    /// Target speed.
-    pub target_speed: f64,
+    /// Target speed, when every target flies at one speed (null for a
+    /// speed mixture).
+    pub target_speed: Option<f64>,
     /// Measured steps per run.
     pub steps: usize,
     /// Seeds averaged.
@@ -173,7 +174,7 @@ pub async fn run_all(
                 policy: cfg.policy.name().to_owned(),
                 scenario: cfg.scenario_id.clone(),
                 sensors: cfg.sensors,
-                target_speed: cfg.scenario.speed,
+                target_speed: cfg.scenario.single_speed(),
                 steps: cfg.steps,
                 seeds: runs.len(),
                 metrics,
@@ -192,16 +193,33 @@ pub const GRID: [(usize, &str); 4] = [
     (6, "paper-v15"),
 ];
 
+/// The `mixed` experiment's grid: the `site-gates` scenario (walkers,
+/// cyclists and vehicles from directed gates) with 10 and 6 sensors.
+pub const MIXED_GRID: [(usize, &str); 2] = [(10, "site-gates"), (6, "site-gates")];
+
+/// The experiments, by name.
+pub const EXPERIMENTS: [&str; 3] = ["table1", "table2", "mixed"];
+
+/// The grid of an experiment: [`GRID`] for the paper's tables,
+/// [`MIXED_GRID`] for `mixed`.
+pub fn experiment_grid(name: &str) -> Option<&'static [(usize, &'static str)]> {
+    match name {
+        "table1" | "table2" => Some(&GRID),
+        "mixed" => Some(&MIXED_GRID),
+        _ => None,
+    }
+}
+
 /// The policies of an experiment, with their row letters: Table 1 compares
-/// the paper's method with (a) and without (b) coordination; Table 2 runs
-/// every policy.
+/// the paper's method with (a) and without (b) coordination; Table 2 and
+/// `mixed` run every policy.
 pub fn experiment_policies(name: &str) -> Option<Vec<(char, Policy)>> {
     match name {
         "table1" => Some(vec![
             ('a', Policy::Paper),
             ('b', Policy::PaperUncoordinated),
         ]),
-        "table2" => Some(('a'..).zip(ALL_POLICIES).collect()),
+        "table2" | "mixed" => Some(('a'..).zip(ALL_POLICIES).collect()),
         _ => None,
     }
 }

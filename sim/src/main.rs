@@ -4,6 +4,7 @@
 //! ```text
 //! vigil-sim --experiment table1 --seeds 10          # the paper's Table 1
 //! vigil-sim --experiment table2                     # every policy
+//! vigil-sim --experiment mixed                      # every policy on site-gates
 //! vigil-sim --policy exact --sensors 10 --svg run.svg
 //! ```
 //! Without `--server` it starts a server in-process on a loopback port and
@@ -16,7 +17,9 @@ use clap::Parser;
 use vigil::scenario::{Scenario, ScenarioSpec};
 use vigil_sim::client::{Client, spawn_local_server};
 use vigil_sim::driver::{Start, default_warmup};
-use vigil_sim::experiment::{GRID, RunConfig, experiment_policies, run_all, run_one};
+use vigil_sim::experiment::{
+    EXPERIMENTS, RunConfig, experiment_grid, experiment_policies, run_all, run_one,
+};
 use vigil_sim::policy::Policy;
 use vigil_sim::{report, svg};
 
@@ -27,8 +30,9 @@ use vigil_sim::{report, svg};
     about = "Drives the Vigil planner step by step over HTTP and reproduces the paper's tables"
 )]
 struct Args {
-    /// Run an experiment grid (NS ∈ {10, 6} × TV ∈ {10, 15}): `table1`
-    /// (paper vs paper-uncoordinated) or `table2` (every policy).
+    /// Run an experiment grid: `table1` (paper vs paper-uncoordinated) or
+    /// `table2` (every policy) over NS ∈ {10, 6} × TV ∈ {10, 15}, or `mixed`
+    /// (every policy on `site-gates` with NS ∈ {10, 6}).
     #[arg(long)]
     experiment: Option<String>,
     /// Policy of a single run.
@@ -125,10 +129,11 @@ async fn run(args: Args) -> Result<(), String> {
         };
     let configs = match &args.experiment {
         Some(name) => {
-            let policies = experiment_policies(name)
-                .ok_or_else(|| format!("unknown experiment `{name}` (table1, table2)"))?;
+            let unknown = || format!("unknown experiment `{name}` ({})", EXPERIMENTS.join(", "));
+            let policies = experiment_policies(name).ok_or_else(unknown)?;
+            let grid = experiment_grid(name).ok_or_else(unknown)?;
             let mut configs = Vec::new();
-            for (n, (sensors, id)) in GRID.iter().enumerate() {
+            for (n, (sensors, id)) in grid.iter().enumerate() {
                 let (id, scenario) = resolve(&client, id).await?;
                 for &(letter, policy) in &policies {
                     configs.push(config(

@@ -38,7 +38,8 @@ pub fn table(rows: &[Row]) -> String {
                 pm(m.d1s, c.d1s, 1),
                 pm(m.d2s, c.d2s, 2),
                 pm(m.d3s, c.d3s, 2),
-                format!("{}", r.target_speed),
+                r.target_speed
+                    .map_or_else(|| "mix".to_owned(), |v| v.to_string()),
                 r.policy.clone(),
                 pm(m.detected_once, c.detected_once, 2),
                 opt(m.calibration, c.calibration, 2),

@@ -13,7 +13,8 @@
 
 use rayon::prelude::*;
 
-use crate::scenario::{Cell, FovSpec, Heading, Scenario};
+use crate::geometry::{Point, Rect, wedge_inv_r_integral};
+use crate::scenario::{Cell, FovSpec, Heading, Scenario, Source};
 
 /// The grid, its prefix table of stationary mass, and each cell's block.
 #[derive(Debug, Clone)]
@@ -107,6 +108,90 @@ fn nearest(xs: &[f64], x: f64) -> usize {
     }
 }
 
+/// `prefix[b·nx + a]`: the stationary targets in `[0, xs[a]] × [0, ys[b]]`,
+/// summed over the target classes. A source whose cone holds the whole zone
+/// uses the antiderivative of `1/r` in an axis-aligned frame that holds the
+/// zone in its half-plane `x' ≥ 0` (a quarter turn flips orientation); one
+/// whose cone cuts the zone integrates each prefix rectangle over the cone
+/// ([`wedge_inv_r_integral`]).
+fn stationary_prefix(s: &Scenario, xs: &[f64], ys: &[f64]) -> Vec<f64> {
+    let (nx, ny) = (xs.len(), ys.len());
+    struct Frame {
+        x: f64,
+        y: f64,
+        ux: f64,
+        uy: f64,
+        /// `Σ_c λ_c/(spread·v_c)`, signed by orientation for the G path.
+        c: f64,
+        source: Source,
+    }
+    let frames: Vec<Frame> = s
+        .sources
+        .iter()
+        .enumerate()
+        .filter(|(_, src)| src.rate > 0.0)
+        .map(|(j, src)| {
+            let u = src.half_plane.unit();
+            let sign = match src.half_plane {
+                Heading::East | Heading::West => 1.0,
+                Heading::North | Heading::South => -1.0,
+            };
+            let c = s
+                .classes_of(j)
+                .iter()
+                .map(|class| sign * class.rate / (src.spread * class.speed))
+                .sum::<f64>();
+            Frame {
+                x: src.pos.x,
+                y: src.pos.y,
+                ux: u.x,
+                uy: u.y,
+                c: if src.covers_zone { c } else { sign * c },
+                source: *src,
+            }
+        })
+        .collect();
+    let g = |f: &Frame, x: f64, y: f64| {
+        let (dx, dy) = (x - f.x, y - f.y);
+        g_half_plane(dx * f.ux + dy * f.uy, -dx * f.uy + dy * f.ux)
+    };
+    let (x0, y0) = (xs[0], ys[0]);
+    let bottom: Vec<Vec<f64>> = frames
+        .iter()
+        .map(|f| xs.iter().map(|&x| g(f, x, y0)).collect())
+        .collect();
+    (0..ny)
+        .into_par_iter()
+        .flat_map_iter(|b| {
+            let y = ys[b];
+            let left: Vec<f64> = frames.iter().map(|f| g(f, x0, y)).collect();
+            let (frames, bottom) = (&frames, &bottom);
+            (0..nx).map(move |a| {
+                frames
+                    .iter()
+                    .enumerate()
+                    .map(|(j, f)| {
+                        if f.source.covers_zone {
+                            f.c * (g(f, xs[a], y) - left[j] - bottom[j][a] + bottom[j][0])
+                        } else {
+                            let rect = Rect {
+                                x0,
+                                y0,
+                                x1: xs[a],
+                                y1: y,
+                            };
+                            let src = &f.source;
+                            f.c * wedge_inv_r_integral(
+                                src.pos, &rect, src.frame, src.cone.0, src.cone.1,
+                            )
+                        }
+                    })
+                    .sum::<f64>()
+            })
+        })
+        .collect()
+}
+
 impl ElementaryGrid {
     /// The grid of a scenario with square fields of view; `None` for circles.
     pub fn new(s: &Scenario) -> Option<Self> {
@@ -128,49 +213,7 @@ impl ElementaryGrid {
         };
         let col_span = span(&xs, s.cols, s.width);
         let row_span = span(&ys, s.rows, s.height);
-        let (nx, ny) = (xs.len(), ys.len());
-        // Per source: rotate into its heading frame (x' ≥ 0 over the zone),
-        // where the antiderivative holds; a quarter turn flips orientation.
-        let frames: Vec<(f64, f64, f64, f64, f64)> = s
-            .sources
-            .iter()
-            .filter(|src| src.rate > 0.0)
-            .map(|src| {
-                let u = src.heading.unit();
-                let sign = match src.heading {
-                    Heading::East | Heading::West => 1.0,
-                    Heading::North | Heading::South => -1.0,
-                };
-                let c = sign * src.rate / (std::f64::consts::PI * s.speed);
-                (src.pos.x, src.pos.y, u.x, u.y, c)
-            })
-            .collect();
-        let g = |f: &(f64, f64, f64, f64, f64), x: f64, y: f64| {
-            let (dx, dy) = (x - f.0, y - f.1);
-            g_half_plane(dx * f.2 + dy * f.3, -dx * f.3 + dy * f.2)
-        };
-        let (x0, y0) = (xs[0], ys[0]);
-        let bottom: Vec<Vec<f64>> = frames
-            .iter()
-            .map(|f| xs.iter().map(|&x| g(f, x, y0)).collect())
-            .collect();
-        let prefix: Vec<f64> = (0..ny)
-            .into_par_iter()
-            .flat_map_iter(|b| {
-                let y = ys[b];
-                let left: Vec<f64> = frames.iter().map(|f| g(f, x0, y)).collect();
-                let (frames, bottom, xs) = (&frames, &bottom, &xs);
-                (0..nx).map(move |a| {
-                    frames
-                        .iter()
-                        .enumerate()
-                        .map(|(j, f)| {
-                            f.4 * (g(f, xs[a], y) - left[j] - bottom[j][a] + bottom[j][0])
-                        })
-                        .sum::<f64>()
-                })
-            })
-            .collect();
+        let prefix = stationary_prefix(s, &xs, &ys);
         let (x_buckets, x_scale) = buckets(&xs);
         let (y_buckets, y_scale) = buckets(&ys);
         Some(ElementaryGrid {
@@ -228,6 +271,84 @@ impl ElementaryGrid {
     }
 }
 
+/// A half-open block `[a0, a1) × [b0, b1)` of elementary rectangles.
+pub(crate) type Block = (usize, usize, usize, usize);
+
+/// Calls `f(a, b, from, to)` for each elementary rectangle `(a, b)` of
+/// `block` the ray segment `[r0, r1]` crosses, in order, with the part of
+/// the segment inside it: a 2-D DDA over the breakpoints. The segment lies
+/// inside the block; rounding at its edge is clamped.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn trace(
+    grid: &ElementaryGrid,
+    block: Block,
+    o: Point,
+    d: Point,
+    inv: Point,
+    r0: f64,
+    r1: f64,
+    mut f: impl FnMut(usize, usize, f64, f64),
+) {
+    let (xs, ys) = (&grid.xs, &grid.ys);
+    let (a_lo, a_hi, b_lo, b_hi) = (block.0, block.1 - 1, block.2, block.3 - 1);
+    let start = Point::new(o.x + d.x * r0, o.y + d.y * r0);
+    let mut a = grid.locate_x(start.x, d.x).clamp(a_lo, a_hi);
+    let mut b = grid.locate_y(start.y, d.y).clamp(b_lo, b_hi);
+    // Distance to the next boundary on each axis (infinite along an axis
+    // the ray runs parallel to).
+    let forward_x = d.x >= 0.0;
+    let forward_y = d.y >= 0.0;
+    let next_x = |a: usize| {
+        if d.x == 0.0 {
+            f64::INFINITY
+        } else {
+            (xs[if forward_x { a + 1 } else { a }] - o.x) * inv.x
+        }
+    };
+    let next_y = |b: usize| {
+        if d.y == 0.0 {
+            f64::INFINITY
+        } else {
+            (ys[if forward_y { b + 1 } else { b }] - o.y) * inv.y
+        }
+    };
+    let (mut tx, mut ty) = (next_x(a), next_y(b));
+    let mut r = r0;
+    loop {
+        let step_x = tx <= ty;
+        let boundary = if step_x { tx } else { ty };
+        let end = if boundary < r1 { boundary } else { r1 };
+        if end > r {
+            f(a, b, r, end);
+            r = end;
+        }
+        if boundary >= r1 {
+            break;
+        }
+        if step_x {
+            if (forward_x && a == a_hi) || (!forward_x && a == a_lo) {
+                break;
+            }
+            if forward_x {
+                a += 1;
+            } else {
+                a -= 1;
+            }
+            tx = next_x(a);
+        } else {
+            if (forward_y && b == b_hi) || (!forward_y && b == b_lo) {
+                break;
+            }
+            if forward_y {
+                b += 1;
+            } else {
+                b -= 1;
+            }
+            ty = next_y(b);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -245,14 +366,20 @@ mod tests {
             y: -9.0,
             rate: 0.4,
             heading: Some(Heading::North),
+            ..SourceSpec::default()
         });
         spec.sources.push(SourceSpec {
             x: 340.0,
             y: 310.0,
             rate: 0.2,
             heading: Some(Heading::West),
+            ..SourceSpec::default()
         });
-        for s in [Scenario::new(spec).expect("valid"), builtins().remove(1)] {
+        for s in [
+            Scenario::new(spec).expect("valid"),
+            builtins().remove(1),
+            builtins().remove(2),
+        ] {
             let grid = ElementaryGrid::new(&s).expect("square");
             let stats = Stats::compute(&s);
             for i in 0..s.cell_count() {

@@ -244,7 +244,7 @@ async fn invalid_specs_are_422() {
     assert_eq!(res.status(), StatusCode::CREATED);
     // Nothing invalid was registered.
     let list: Value = app.get("/v1/scenarios").await.json().await.unwrap();
-    assert_eq!(list["scenarios"].as_array().unwrap().len(), 3);
+    assert_eq!(list["scenarios"].as_array().unwrap().len(), 4);
 }
 
 /// POSTs `plan_request()` changed by `edit` to paper-v10 and expects a 422

@@ -1,4 +1,5 @@
-//! The model: zone, lattice of cells, sources, field of view, target speed.
+//! The model: zone, lattice of cells, sources and target classes, field of
+//! view.
 //!
 //! [`ScenarioSpec`] is what clients send; [`Scenario`] is the validated form,
 //! built once by [`Scenario::new`] (parse, don't validate), so the rest of the
@@ -9,6 +10,12 @@ use sha2::{Digest, Sha256};
 use utoipa::ToSchema;
 
 use crate::geometry::{Disk, Point, Rect, Region};
+
+mod source;
+
+pub use source::{
+    Heading, MAX_SPEED_CLASSES, Source, SourceSpec, SpeedSpec, TargetClass, infer_heading,
+};
 
 /// Largest planning horizon accepted.
 pub const MAX_HORIZON: usize = 12;
@@ -75,49 +82,6 @@ pub enum FovSpec {
     },
 }
 
-/// Direction a source's takeoff half-plane faces.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
-#[serde(rename_all = "lowercase")]
-pub enum Heading {
-    /// +x.
-    East,
-    /// −x.
-    West,
-    /// +y.
-    North,
-    /// −y.
-    South,
-}
-
-impl Heading {
-    /// Unit vector of the heading.
-    pub fn unit(self) -> Point {
-        match self {
-            Heading::East => Point::new(1.0, 0.0),
-            Heading::West => Point::new(-1.0, 0.0),
-            Heading::North => Point::new(0.0, 1.0),
-            Heading::South => Point::new(0.0, -1.0),
-        }
-    }
-}
-
-/// A point source of targets outside the zone.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-#[schema(examples(json!({"x": -1.0, "y": 100.0, "rate": 0.3, "heading": "east"})))]
-pub struct SourceSpec {
-    /// East coordinate.
-    pub x: f64,
-    /// North coordinate.
-    pub y: f64,
-    /// Poisson rate, targets per step.
-    #[schema(minimum = 0)]
-    pub rate: f64,
-    /// Takeoff half-plane; inferred when the source is beside exactly one edge.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub heading: Option<Heading>,
-}
-
 /// A scenario as clients send it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
@@ -134,9 +98,11 @@ pub struct ScenarioSpec {
     pub cell_size: f64,
     /// Sensors' field of view.
     pub fov: FovSpec,
-    /// Distance a target flies per step.
+    /// Distance a target flies per step, for the sources that give no
+    /// `speeds` (required unless every source gives them).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(exclusive_minimum = 0)]
-    pub target_speed: f64,
+    pub target_speed: Option<f64>,
     /// Target sources.
     #[schema(max_items = 64)]
     pub sources: Vec<SourceSpec>,
@@ -153,36 +119,6 @@ pub struct Cell {
     pub col: i32,
     /// Row, from the south edge.
     pub row: i32,
-}
-
-/// A validated source: position, rate and takeoff frame.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Source {
-    /// Position.
-    pub pos: Point,
-    /// Targets per step.
-    pub rate: f64,
-    /// Takeoff half-plane.
-    pub heading: Heading,
-}
-
-impl Source {
-    /// Unit direction of takeoff angle `alpha ∈ [−π/2, π/2]` measured from the
-    /// heading, counter-clockwise.
-    #[inline]
-    pub fn direction(&self, alpha: f64) -> Point {
-        let h = self.heading.unit();
-        let (s, c) = alpha.sin_cos();
-        Point::new(c * h.x - s * h.y, c * h.y + s * h.x)
-    }
-
-    /// Takeoff angle of the direction towards `p` (see [`Source::direction`]).
-    #[inline]
-    pub fn angle_to(&self, p: Point) -> f64 {
-        let h = self.heading.unit();
-        let (dx, dy) = (p.x - self.pos.x, p.y - self.pos.y);
-        (h.x * dy - h.y * dx).atan2(h.x * dx + h.y * dy)
-    }
 }
 
 /// A validated scenario.
@@ -204,10 +140,12 @@ pub struct Scenario {
     pub rows: i32,
     /// Field of view.
     pub fov: FovSpec,
-    /// Target speed per step.
-    pub speed: f64,
     /// Sources.
     pub sources: Vec<Source>,
+    /// Target classes (source × speed), grouped by source in source order.
+    pub classes: Vec<TargetClass>,
+    /// Source `j`'s classes are `classes[class_offsets[j]..class_offsets[j+1]]`.
+    class_offsets: Vec<usize>,
     /// Default horizon.
     pub horizon: usize,
 }
@@ -289,7 +227,16 @@ impl Scenario {
                 finite_positive("fov.radius", radius)?;
             }
         }
-        let speed = finite_positive("target_speed", spec.target_speed)?;
+        let target_speed = spec
+            .target_speed
+            .map(|v| finite_positive("target_speed", v))
+            .transpose()?;
+        if spec.sources.is_empty() {
+            return Err(ValidationError::new(
+                "sources",
+                "at least one source: a zone without sources has no targets",
+            ));
+        }
         if spec.sources.len() > MAX_SOURCES {
             return Err(ValidationError::new(
                 "sources",
@@ -297,67 +244,19 @@ impl Scenario {
             ));
         }
         let mut sources = Vec::with_capacity(spec.sources.len());
+        let mut classes = Vec::with_capacity(spec.sources.len());
         let mut canonical_sources = Vec::with_capacity(spec.sources.len());
+        let mut class_offsets = vec![0];
         for (i, s) in spec.sources.iter().enumerate() {
-            let f = |name: &str| format!("sources[{i}].{name}");
-            if !s.x.is_finite() {
-                return Err(ValidationError::new(f("x"), "must be finite"));
-            }
-            if !s.y.is_finite() {
-                return Err(ValidationError::new(f("y"), "must be finite"));
-            }
-            if !(s.rate.is_finite() && s.rate >= 0.0) {
-                return Err(ValidationError::new(
-                    f("rate"),
-                    format!("must be finite and ≥ 0, got {}", s.rate),
-                ));
-            }
-            if (0.0..=width).contains(&s.x) && (0.0..=height).contains(&s.y) {
-                return Err(ValidationError::new(
-                    format!("sources[{i}]"),
-                    format!(
-                        "({}, {}) is inside the zone [0,{width}]×[0,{height}]; sources must be strictly outside",
-                        s.x, s.y
-                    ),
-                ));
-            }
-            let heading = match s.heading {
-                Some(h) => h,
-                None => infer_heading(s.x, s.y, width, height).ok_or_else(|| {
-                    ValidationError::new(
-                        f("heading"),
-                        "required: the source is not beside exactly one edge of the zone",
-                    )
-                })?,
-            };
-            // The takeoff half-plane must face the zone, so every target can
-            // reach any part of it and the zone lies in front of the source.
-            let faces = match heading {
-                Heading::East => s.x <= 0.0,
-                Heading::West => s.x >= width,
-                Heading::North => s.y <= 0.0,
-                Heading::South => s.y >= height,
-            };
-            if !faces {
-                return Err(ValidationError::new(
-                    f("heading"),
-                    format!(
-                        "{} does not face the zone from ({}, {}): the whole zone must lie in the takeoff half-plane",
-                        serde_json::to_string(&heading).unwrap_or_default(),
-                        s.x,
-                        s.y
-                    ),
-                ));
-            }
-            sources.push(Source {
-                pos: Point::new(s.x, s.y),
-                rate: s.rate,
-                heading,
-            });
-            canonical_sources.push(SourceSpec {
-                heading: Some(heading),
-                ..*s
-            });
+            let v = source::validate(i, s, width, height, target_speed)?;
+            classes.extend(v.speeds.iter().map(|&(speed, weight)| TargetClass {
+                source: i,
+                speed,
+                rate: v.source.rate * weight,
+            }));
+            class_offsets.push(classes.len());
+            sources.push(v.source);
+            canonical_sources.push(v.canonical);
         }
         let horizon = check_horizon("horizon", spec.horizon.unwrap_or(DEFAULT_HORIZON))?;
         let canonical = ScenarioSpec {
@@ -378,10 +277,36 @@ impl Scenario {
             cols,
             rows,
             fov: spec.fov,
-            speed,
             sources,
+            classes,
+            class_offsets,
             horizon,
         })
+    }
+
+    /// The classes of source `j`.
+    #[inline]
+    pub fn classes_of(&self, j: usize) -> &[TargetClass] {
+        &self.classes[self.class_offsets[j]..self.class_offsets[j + 1]]
+    }
+
+    /// The target speed, when every class flies at the same one.
+    pub fn single_speed(&self) -> Option<f64> {
+        let v = self.classes.first()?.speed;
+        self.classes.iter().all(|c| c.speed == v).then_some(v)
+    }
+
+    /// The slowest target speed of any class.
+    pub fn min_speed(&self) -> f64 {
+        self.classes
+            .iter()
+            .map(|c| c.speed)
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The fastest target speed of any class.
+    pub fn max_speed(&self) -> f64 {
+        self.classes.iter().map(|c| c.speed).fold(0.0, f64::max)
     }
 
     /// Number of cells.
@@ -473,26 +398,6 @@ impl Scenario {
     }
 }
 
-/// The heading of a source beside exactly one edge, if any.
-pub fn infer_heading(x: f64, y: f64, w: f64, h: f64) -> Option<Heading> {
-    let beside_x = (0.0..=h).contains(&y);
-    let beside_y = (0.0..=w).contains(&x);
-    let mut found = None;
-    let mut count = 0;
-    for (cond, heading) in [
-        (x < 0.0 && beside_x, Heading::East),
-        (x > w && beside_x, Heading::West),
-        (y < 0.0 && beside_y, Heading::North),
-        (y > h && beside_y, Heading::South),
-    ] {
-        if cond {
-            count += 1;
-            found = Some(heading);
-        }
-    }
-    (count == 1).then_some(found).flatten()
-}
-
 /// Id of a canonical spec: `s-` and the first 16 hex digits of the SHA-256 of
 /// its JSON (fields in declaration order, so the same spec gives the same id).
 pub fn derive_id(canonical: &ScenarioSpec) -> String {
@@ -503,17 +408,12 @@ pub fn derive_id(canonical: &ScenarioSpec) -> String {
 }
 
 /// Names of the built-in scenarios.
-pub const BUILTIN_IDS: [&str; 2] = ["paper-v10", "paper-v15"];
+pub const BUILTIN_IDS: [&str; 3] = ["paper-v10", "paper-v15", "site-gates"];
 
 /// The paper's setting: a 300×300 zone, 10-unit cells, square FOV of half
 /// width 30, eight sources of rate 0.3 at a third and two thirds of each edge.
 pub fn paper_spec(target_speed: f64) -> ScenarioSpec {
-    let src = |x: f64, y: f64| SourceSpec {
-        x,
-        y,
-        rate: 0.3,
-        heading: None,
-    };
+    let src = |x: f64, y: f64| SourceSpec::at(x, y, 0.3);
     ScenarioSpec {
         name: Some(format!("paper, target speed {target_speed}")),
         zone: ZoneSpec {
@@ -522,7 +422,7 @@ pub fn paper_spec(target_speed: f64) -> ScenarioSpec {
         },
         cell_size: 10.0,
         fov: FovSpec::Square { half_width: 30.0 },
-        target_speed,
+        target_speed: Some(target_speed),
         sources: vec![
             src(-1.0, 100.0),
             src(-1.0, 200.0),
@@ -537,36 +437,78 @@ pub fn paper_spec(target_speed: f64) -> ScenarioSpec {
     }
 }
 
-/// The built-in scenarios, `paper-v10` and `paper-v15`.
+/// Speeds of the `site-gates` scenario, metres per step: a walker, a
+/// cyclist and a vehicle.
+pub const SITE_WALKER: f64 = 1.5;
+/// See [`SITE_WALKER`].
+pub const SITE_CYCLIST: f64 = 5.0;
+/// See [`SITE_WALKER`].
+pub const SITE_VEHICLE: f64 = 12.0;
+
+/// `site-gates`: a 400 m × 300 m industrial site in 10 m cells, watched by
+/// sensors with the paper's 60 m square field of view. Targets come
+/// through four openings in the fence, each with its own cone and mix:
+/// - the main road gate on the west side, aimed east along the site road
+///   (±15°): vehicles and walkers, two to one;
+/// - a footpath gate in the south fence, aimed north-north-east (±20°):
+///   mostly walkers, some cyclists;
+/// - a delivery gate at the north-east corner, aimed along the yard
+///   (200°, ±10°): vehicles and a few walkers, five to one;
+/// - a breach in the north fence, where people climb over anywhere into
+///   the half-plane below it (a 120° fan): walkers only.
+pub fn site_gates_spec() -> ScenarioSpec {
+    let class = |speed: f64, weight: f64| SpeedSpec { speed, weight };
+    let gate = |x: f64, y: f64, rate: f64, direction: f64, spread: f64| SourceSpec {
+        direction: Some(direction),
+        spread: Some(spread),
+        ..SourceSpec::at(x, y, rate)
+    };
+    ScenarioSpec {
+        name: Some("site with gates: walkers, cyclists and vehicles".into()),
+        zone: ZoneSpec {
+            width: 400.0,
+            height: 300.0,
+        },
+        cell_size: 10.0,
+        fov: FovSpec::Square { half_width: 30.0 },
+        target_speed: None,
+        sources: vec![
+            SourceSpec {
+                speeds: Some(vec![class(SITE_VEHICLE, 2.0), class(SITE_WALKER, 1.0)]),
+                ..gate(-1.0, 150.0, 0.3, 0.0, 30.0)
+            },
+            SourceSpec {
+                speeds: Some(vec![class(SITE_WALKER, 3.0), class(SITE_CYCLIST, 1.0)]),
+                ..gate(120.0, -1.0, 0.1, 70.0, 40.0)
+            },
+            SourceSpec {
+                speeds: Some(vec![class(SITE_VEHICLE, 5.0), class(SITE_WALKER, 1.0)]),
+                ..gate(401.0, 301.0, 0.3, 200.0, 20.0)
+            },
+            SourceSpec {
+                heading: Some(Heading::South),
+                spread: Some(120.0),
+                speeds: Some(vec![class(SITE_WALKER, 1.0)]),
+                ..SourceSpec::at(250.0, 301.0, 0.03)
+            },
+        ],
+        horizon: Some(3),
+    }
+}
+
+/// The built-in scenarios: `paper-v10` and `paper-v15` (the paper's), and
+/// `site-gates` ([`site_gates_spec`]).
 pub fn builtins() -> Vec<Scenario> {
-    BUILTIN_IDS
-        .iter()
-        .zip([10.0, 15.0])
-        .map(|(id, v)| Scenario::build(paper_spec(v), Some(id)).expect("built-in specs are valid"))
+    [paper_spec(10.0), paper_spec(15.0), site_gates_spec()]
+        .into_iter()
+        .zip(BUILTIN_IDS)
+        .map(|(spec, id)| Scenario::build(spec, Some(id)).expect("built-in specs are valid"))
         .collect()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn headings_are_inferred_beside_one_edge_only() {
-        assert_eq!(
-            infer_heading(-1.0, 100.0, 300.0, 300.0),
-            Some(Heading::East)
-        );
-        assert_eq!(infer_heading(301.0, 0.0, 300.0, 300.0), Some(Heading::West));
-        assert_eq!(
-            infer_heading(100.0, -1.0, 300.0, 300.0),
-            Some(Heading::North)
-        );
-        assert_eq!(
-            infer_heading(100.0, 301.0, 300.0, 300.0),
-            Some(Heading::South)
-        );
-        assert_eq!(infer_heading(-1.0, -1.0, 300.0, 300.0), None);
-    }
 
     #[test]
     fn ids_are_deterministic_and_canonical() {
@@ -589,12 +531,7 @@ mod tests {
         s.sources[3].y = 150.0;
         assert_eq!(Scenario::new(s).unwrap_err().field, "sources[3]");
         let mut s = paper_spec(10.0);
-        s.sources[0] = SourceSpec {
-            x: -1.0,
-            y: -1.0,
-            rate: 1.0,
-            heading: None,
-        };
+        s.sources[0] = SourceSpec::at(-1.0, -1.0, 1.0);
         assert_eq!(Scenario::new(s).unwrap_err().field, "sources[0].heading");
         let mut s = paper_spec(10.0);
         s.sources[0].heading = Some(Heading::West);
@@ -603,7 +540,7 @@ mod tests {
         s.horizon = Some(13);
         assert_eq!(Scenario::new(s).unwrap_err().field, "horizon");
         let mut s = paper_spec(10.0);
-        s.target_speed = f64::NAN;
+        s.target_speed = Some(f64::NAN);
         assert_eq!(Scenario::new(s).unwrap_err().field, "target_speed");
         let mut s = paper_spec(10.0);
         s.cell_size = 0.01;

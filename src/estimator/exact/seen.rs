@@ -1,0 +1,135 @@
+//! Seen sets along rays: for each ray of a source, the union of what the
+//! sensors' fields of view covered now and in the history, each interval
+//! pushed by the distance a target has flown since.
+
+use super::rays::SourceRays;
+use super::{max, min};
+use crate::geometry::Region;
+
+/// What the rays of one source saw: per ray, the union of the intervals
+/// seen `s` steps ago, each pushed by `v·s` (the distance a target has flown
+/// since), merged into sorted disjoint intervals. At step `t` the seen set is
+/// the same union pushed a further `v·t`. Stored compactly, ray by ray.
+pub(super) struct RayHits {
+    /// `hits[offsets[m]..offsets[m+1]]` are ray `m`'s intervals.
+    offsets: Vec<u32>,
+    hits: Vec<(f64, f64)>,
+}
+
+impl RayHits {
+    pub(super) fn new(sr: &SourceRays, observed: &[Vec<Region>], speed: f64) -> Self {
+        let mut buf = Vec::new();
+        let n = sr.dirs.len();
+        let o = sr.source.pos;
+        // Regions go track by track (the i-th region of every step: one
+        // sensor's fields of view, newest first). Consecutive ones overlap on
+        // most rays, so each ray's intervals from one track are merged as
+        // they come, in a buffer over the track's rays; what is left (about
+        // one interval per ray and track) is sorted by ray afterwards.
+        let tracks = observed.iter().map(Vec::len).max().unwrap_or(0);
+        let mut pieces: Vec<(u32, f64, f64)> = Vec::new();
+        let mut open: Vec<(f64, f64)> = Vec::new();
+        let mut spans = Vec::with_capacity(observed.len());
+        for i in 0..tracks {
+            spans.clear();
+            let (mut lo, mut hi) = (n, 0);
+            for (s, regions) in observed.iter().enumerate() {
+                let Some(region) = regions.get(i) else {
+                    continue;
+                };
+                if let Some((a, b)) = sr.range(region, &mut buf) {
+                    spans.push((a, b, speed * s as f64, region));
+                    (lo, hi) = (lo.min(a), hi.max(b));
+                }
+            }
+            if spans.is_empty() {
+                continue;
+            }
+            open.clear();
+            open.resize(hi - lo, EMPTY);
+            for &(a, b, shift, region) in &spans {
+                let open = &mut open[a - lo..b - lo];
+                if region.disk.is_none() {
+                    // Slab test, branch-free (no direction component is 0).
+                    let r = &region.rect;
+                    let (x0, x1, y0, y1) = (r.x0 - o.x, r.x1 - o.x, r.y0 - o.y, r.y1 - o.y);
+                    for (j, (&(_, inv), cur)) in sr.dirs[a..b].iter().zip(open).enumerate() {
+                        let (tx0, tx1) = (x0 * inv.x, x1 * inv.x);
+                        let (ty0, ty1) = (y0 * inv.y, y1 * inv.y);
+                        let p = max(max(min(tx0, tx1), min(ty0, ty1)), 0.0);
+                        let q = min(max(tx0, tx1), max(ty0, ty1));
+                        if p <= q {
+                            extend(cur, (a + j) as u32, p + shift, q + shift, &mut pieces);
+                        }
+                    }
+                } else {
+                    for (j, cur) in open.iter_mut().enumerate() {
+                        let (d, inv) = sr.dirs[a + j];
+                        if let Some((p, q)) = region.ray(o, d, inv) {
+                            extend(cur, (a + j) as u32, p + shift, q + shift, &mut pieces);
+                        }
+                    }
+                }
+            }
+            for (j, &(p, q)) in open.iter().enumerate() {
+                if p <= q {
+                    pieces.push(((lo + j) as u32, p, q));
+                }
+            }
+        }
+        // By ray (a counting sort), then each ray's few pieces by start,
+        // merged into sorted disjoint intervals.
+        let mut offsets = vec![0u32; n + 1];
+        for &(m, ..) in &pieces {
+            offsets[m as usize + 1] += 1;
+        }
+        for m in 0..n {
+            offsets[m + 1] += offsets[m];
+        }
+        let mut next = offsets.clone();
+        let mut sorted = vec![(0.0, 0.0); pieces.len()];
+        for &(m, p, q) in &pieces {
+            sorted[next[m as usize] as usize] = (p, q);
+            next[m as usize] += 1;
+        }
+        let mut hits: Vec<(f64, f64)> = Vec::with_capacity(sorted.len());
+        let mut start = 0;
+        for m in 0..n {
+            let list = &mut sorted[start..offsets[m + 1] as usize];
+            start = offsets[m + 1] as usize;
+            list.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+            let first = hits.len();
+            for &(p, q) in list.iter() {
+                match hits[first..].last_mut() {
+                    Some(last) if p <= last.1 => last.1 = last.1.max(q),
+                    _ => hits.push((p, q)),
+                }
+            }
+            offsets[m + 1] = hits.len() as u32;
+        }
+        RayHits { offsets, hits }
+    }
+
+    /// Ray `m`'s seen intervals (sorted, disjoint) as of step 0.
+    #[inline]
+    pub(super) fn of(&self, m: usize) -> &[(f64, f64)] {
+        &self.hits[self.offsets[m] as usize..self.offsets[m + 1] as usize]
+    }
+}
+
+/// No interval yet (`p > q`).
+const EMPTY: (f64, f64) = (f64::INFINITY, f64::NEG_INFINITY);
+
+/// Extends `cur`, ray `m`'s interval being merged, by `[p, q]` when they
+/// overlap; otherwise moves `cur` to `pieces` and starts again from `[p, q]`.
+#[inline]
+fn extend(cur: &mut (f64, f64), m: u32, p: f64, q: f64, pieces: &mut Vec<(u32, f64, f64)>) {
+    if p <= cur.1 && q >= cur.0 {
+        *cur = (min(cur.0, p), max(cur.1, q));
+    } else {
+        if cur.0 <= cur.1 {
+            pieces.push((m, cur.0, cur.1));
+        }
+        *cur = (p, q);
+    }
+}

@@ -1,0 +1,340 @@
+//! Step windows: the unseen mass at step `t` of each elementary rectangle
+//! near the sensors, accumulated once per step from the seen sets, and the
+//! prefix sums that turn a cell's value into four lookups.
+
+use std::sync::OnceLock;
+
+use rayon::prelude::*;
+
+use super::rays::SourceRays;
+use super::seen::RayHits;
+use super::{ExactEstimator, max, min};
+use crate::estimator::elementary::{Block, ElementaryGrid, trace};
+use crate::geometry::{Point, Region};
+use crate::scenario::{Cell, Scenario};
+
+/// Prefix sums over a block of rectangles.
+pub(super) struct BlockSums {
+    a0: usize,
+    b0: usize,
+    w: usize,
+    prefix: Vec<f64>,
+}
+
+impl BlockSums {
+    /// The sum over a sub-block (global indices).
+    #[inline]
+    pub(super) fn sum(&self, (a0, a1, b0, b1): Block) -> f64 {
+        let p = |a: usize, b: usize| self.prefix[(b - self.b0) * self.w + (a - self.a0)];
+        p(a1, b1) - p(a0, b1) - p(a1, b0) + p(a0, b0)
+    }
+}
+
+/// The windows of one step: one shared by every sensor when their reaches
+/// lie close together (each seen interval is walked once), otherwise one
+/// per sensor (memory bounded by the reaches on a large lattice).
+pub(super) struct StepWindows {
+    pub(super) blocks: Vec<Block>,
+    pub(super) built: Vec<OnceLock<Window>>,
+    pub(super) slot: Vec<usize>,
+}
+
+impl StepWindows {
+    pub(super) fn new(grid: &ElementaryGrid, s: &Scenario, starts: &[Cell], t: usize) -> Self {
+        let ti = t as i32;
+        let reach: Vec<Block> = starts
+            .iter()
+            .map(|start| {
+                let lo = Cell {
+                    col: (start.col - ti).max(0),
+                    row: (start.row - ti).max(0),
+                };
+                let hi = Cell {
+                    col: (start.col + ti).min(s.cols - 1),
+                    row: (start.row + ti).min(s.rows - 1),
+                };
+                let (a0, _, b0, _) = grid.span(lo);
+                let (_, a1, _, b1) = grid.span(hi);
+                (a0, a1, b0, b1)
+            })
+            .collect();
+        let size = |b: &Block| (b.1 - b.0) * (b.3 - b.2);
+        let bbox = reach.iter().fold((usize::MAX, 0, usize::MAX, 0), |acc, b| {
+            (
+                acc.0.min(b.0),
+                acc.1.max(b.1),
+                acc.2.min(b.2),
+                acc.3.max(b.3),
+            )
+        });
+        let total: usize = reach.iter().map(size).sum();
+        let (nx, ny) = grid.dims();
+        if nx * ny <= 1 << 16 {
+            // A small grid: one window over all of it (the fastest to fill).
+            Self {
+                blocks: vec![(0, nx, 0, ny)],
+                built: vec![OnceLock::new()],
+                slot: vec![0; reach.len()],
+            }
+        } else if !reach.is_empty() && size(&bbox) <= (1 << 16).max(2 * total) {
+            Self {
+                blocks: vec![bbox],
+                built: vec![OnceLock::new()],
+                slot: vec![0; reach.len()],
+            }
+        } else {
+            Self {
+                built: reach.iter().map(|_| OnceLock::new()).collect(),
+                slot: (0..reach.len()).collect(),
+                blocks: reach,
+            }
+        }
+    }
+}
+
+/// `u_t(E)` over a block of elementary rectangles: the expected targets in
+/// each at step `t` that no sensor can have seen.
+pub(super) struct Window {
+    pub(super) a0: usize,
+    pub(super) b0: usize,
+    pub(super) na: usize,
+    pub(super) nb: usize,
+    unseen: Vec<f64>,
+}
+
+impl ExactEstimator<'_> {
+    /// The unseen mass at step `t` of the elementary rectangles of a block.
+    pub(super) fn window(
+        &self,
+        grid: &ElementaryGrid,
+        (a0, a1, b0, b1): Block,
+        t: usize,
+    ) -> Window {
+        let (na, nb) = (a1 - a0, b1 - b0);
+        let mut unseen = Vec::with_capacity(na * nb);
+        for b in b0..b1 {
+            for a in a0..a1 {
+                unseen.push(grid.mass(a, a + 1, b, b + 1));
+            }
+        }
+        let block = (a0, a1, b0, b1);
+        let whole = {
+            let (nx, ny) = grid.dims();
+            block == (0, nx, 0, ny)
+        };
+        // The classes split among the threads, each adding into its own
+        // buffer (one per thread, not per class: the buffers are summed).
+        let chunk = self
+            .classes
+            .len()
+            .div_ceil(rayon::current_num_threads())
+            .max(1);
+        let per_thread: Vec<Vec<f64>> = self
+            .classes
+            .par_chunks(chunk)
+            .zip(self.seen.par_chunks(chunk))
+            .map(|(classes, seen)| {
+                let mut acc = vec![0.0; na * nb];
+                for (class, seen) in classes.iter().zip(seen) {
+                    let sr = &self.rays[class.rays];
+                    let lift = class.speed * t as f64;
+                    self.accumulate(grid, block, whole, lift, sr, class.weight, seen, &mut acc);
+                }
+                acc
+            })
+            .collect();
+        let mut per_thread = per_thread.into_iter();
+        if let Some(first) = per_thread.next() {
+            for (u, s) in unseen.iter_mut().zip(&first) {
+                *u -= s;
+            }
+            for acc in per_thread {
+                for (u, s) in unseen.iter_mut().zip(&acc) {
+                    *u -= s;
+                }
+            }
+        }
+        Window {
+            a0,
+            b0,
+            na,
+            nb,
+            unseen,
+        }
+    }
+
+    /// Adds to `acc` what the rays of one source saw in each rectangle of
+    /// `block` at lift `v·t`, times the class's weight `w`.
+    #[allow(clippy::too_many_arguments)]
+    fn accumulate(
+        &self,
+        grid: &ElementaryGrid,
+        block: Block,
+        whole: bool,
+        lift: f64,
+        sr: &SourceRays,
+        w: f64,
+        seen: &RayHits,
+        acc: &mut [f64],
+    ) {
+        if let (true, Some(cr)) = (whole, &sr.crossings) {
+            // The block is the grid: every ray, no bounds to check.
+            for m in 0..sr.dirs.len() {
+                let (rs, _, lin) = cr.of(m);
+                let hits = seen.of(m);
+                if hits.is_empty() || lin.is_empty() {
+                    continue;
+                }
+                let end = rs[lin.len()] - lift;
+                let from = hits.partition_point(|&(_, q)| q + lift <= rs[0]);
+                let mut k = usize::MAX;
+                for &(p, q) in &hits[from..] {
+                    if p >= end {
+                        break;
+                    }
+                    let (p, q) = (p + lift, q + lift);
+                    k = next_crossing(rs, k, p);
+                    while k < lin.len() && rs[k] < q {
+                        acc[lin[k] as usize] += w * (min(rs[k + 1], q) - max(rs[k], p));
+                        k += 1;
+                    }
+                }
+            }
+            return;
+        }
+        let (a0, a1, b0, b1) = block;
+        let na = a1 - a0;
+        let region = Region {
+            rect: crate::geometry::Rect {
+                x0: grid.xs[a0],
+                y0: grid.ys[b0],
+                x1: grid.xs[a1],
+                y1: grid.ys[b1],
+            },
+            disk: None,
+        };
+        let mut buf = Vec::new();
+        let Some((ma, mb)) = sr.range(&region, &mut buf) else {
+            return;
+        };
+        for m in ma..mb {
+            let hits = seen.of(m);
+            if hits.is_empty() {
+                continue;
+            }
+            let (d, inv) = sr.dirs[m];
+            let Some((wa, wb)) = region.ray(sr.source.pos, d, inv) else {
+                continue;
+            };
+            // The seen union at step t, clipped to the block.
+            let (wa, wb) = (wa - lift, wb - lift);
+            let from = hits.partition_point(|&(_, q)| q <= wa);
+            let Some(cr) = &sr.crossings else {
+                for &(p, q) in &hits[from..] {
+                    if p >= wb {
+                        break;
+                    }
+                    let (p, q) = (max(p, wa) + lift, min(q, wb) + lift);
+                    if q > p {
+                        walk(grid, block, acc, sr.source.pos, d, inv, p, q, w);
+                    }
+                }
+                continue;
+            };
+            let (rs, cells, _) = cr.of(m);
+            let mut k = usize::MAX;
+            for &(p, q) in &hits[from..] {
+                if p >= wb {
+                    break;
+                }
+                let (p, q) = (max(p, wa) + lift, min(q, wb) + lift);
+                if q <= p {
+                    continue;
+                }
+                k = next_crossing(rs, k, p);
+                while k < cells.len() && rs[k] < q {
+                    let len = min(rs[k + 1], q) - max(rs[k], p);
+                    let [a, b] = cells[k];
+                    let (a, b) = (a as usize, b as usize);
+                    // Rounding at the block's edge: a sliver outside is dropped.
+                    if len > 0.0 && (a0..a1).contains(&a) && (b0..b1).contains(&b) {
+                        acc[(b - b0) * na + (a - a0)] += w * len;
+                    }
+                    k += 1;
+                }
+            }
+        }
+    }
+
+    /// Prefix sums of the unseen mass over `block` (global indices, inside
+    /// the window), leaving out the rectangles of excluded regions (fields
+    /// of view are unions of rectangles: those whose centre they contain).
+    pub(super) fn block_sums(
+        &self,
+        grid: &ElementaryGrid,
+        win: &Window,
+        block: Block,
+        excluded: &[Region],
+    ) -> BlockSums {
+        let (a0, a1, b0, b1) = block;
+        let w = a1 - a0 + 1;
+        let mut prefix = vec![0.0; w * (b1 - b0 + 1)];
+        let xc: Vec<f64> = (a0..a1)
+            .map(|a| 0.5 * (grid.xs[a] + grid.xs[a + 1]))
+            .collect();
+        for (j, b) in (b0..b1).enumerate() {
+            let yc = 0.5 * (grid.ys[b] + grid.ys[b + 1]);
+            let rows: Vec<&Region> = excluded
+                .iter()
+                .filter(|x| yc >= x.rect.y0 && yc <= x.rect.y1)
+                .collect();
+            let mut row = 0.0;
+            for (i, a) in (a0..a1).enumerate() {
+                if !rows
+                    .iter()
+                    .any(|x| xc[i] >= x.rect.x0 && xc[i] <= x.rect.x1)
+                {
+                    row += win.unseen[(b - win.b0) * win.na + (a - win.a0)];
+                }
+                prefix[(j + 1) * w + i + 1] = prefix[j * w + i + 1] + row;
+            }
+        }
+        BlockSums { a0, b0, w, prefix }
+    }
+}
+
+/// The crossing whose segment holds `p`, for the intervals of one ray in
+/// order: `k` is where the previous interval ended (`usize::MAX` before the
+/// first). The first is found by bisection, the next by scanning on from the
+/// last: the gaps are short, and a scan is cheaper than dependent loads.
+#[inline]
+fn next_crossing(rs: &[f64], k: usize, p: f64) -> usize {
+    if k == usize::MAX {
+        return rs.partition_point(|&x| x <= p).saturating_sub(1);
+    }
+    let mut k = k.saturating_sub(1);
+    while k + 1 < rs.len() && rs[k + 1] <= p {
+        k += 1;
+    }
+    k
+}
+
+/// Adds to `acc`, the seen mass in each elementary rectangle of `block`,
+/// the ray segment `[r0, r1]` times `w`, rectangle by rectangle.
+#[allow(clippy::too_many_arguments)]
+fn walk(
+    grid: &ElementaryGrid,
+    block: Block,
+    acc: &mut [f64],
+    o: Point,
+    d: Point,
+    inv: Point,
+    r0: f64,
+    r1: f64,
+    w: f64,
+) {
+    let (a_lo, b_lo, na) = (block.0, block.2, block.1 - block.0);
+    trace(grid, block, o, d, inv, r0, r1, |a, b, from, to| {
+        acc[(b - b_lo) * na + (a - a_lo)] += w * (to - from);
+    });
+}

@@ -1,0 +1,78 @@
+//! The paper's built-ins answer exactly as before the target model grew
+//! (speed mixtures and cones): the statistics of `paper-v10` and
+//! `paper-v15` (and of a circular-field-of-view variant), and the plans for
+//! recorded requests of a `vigil-sim` run with 16 steps of history, for
+//! every estimator and coordination, are bit for bit the ones recorded in
+//! `tests/golden/paper-builtins.json` before the change (SHA-256 of their
+//! JSON, compute time zeroed), and the ids of stored specs are unchanged.
+#![allow(clippy::unwrap_used, missing_docs)]
+
+use serde_json::{Value, json};
+use sha2::{Digest, Sha256};
+use vigil::planner::{PlanRequest, Planner};
+use vigil::scenario::{Scenario, ScenarioSpec, builtins};
+
+fn digest(v: &Value) -> String {
+    let d = Sha256::digest(serde_json::to_string(v).unwrap().as_bytes());
+    d.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+#[test]
+fn paper_builtins_answer_exactly_as_before() {
+    let doc: Value = serde_json::from_str(include_str!("golden/paper-builtins.json")).unwrap();
+    let builtins = builtins();
+    let mut checked = 0;
+    for sc in doc["scenarios"].as_array().unwrap() {
+        let id = sc["id"].as_str().unwrap();
+        let scenario = match builtins.iter().find(|b| b.id == id) {
+            Some(b) => b.clone(),
+            None => {
+                let spec: ScenarioSpec = serde_json::from_value(sc["spec"].clone()).unwrap();
+                Scenario::new(spec).unwrap()
+            }
+        };
+        assert_eq!(scenario.id, id);
+        assert_eq!(
+            serde_json::to_value(&scenario.spec).unwrap(),
+            sc["spec"],
+            "{id}: spec"
+        );
+        let planner = Planner::new(scenario);
+        let st = &planner.stats;
+        let stats = json!({
+            "lambda_hat": st.lambda_hat, "escape_time": st.escape_time, "d_hat": st.d_hat,
+            "expected_targets_in_zone": st.expected_targets_in_zone,
+        });
+        assert_eq!(
+            digest(&stats),
+            sc["stats_sha256"],
+            "{id}: statistics changed"
+        );
+        let bases = sc["bases"].as_array().unwrap();
+        for (i, case) in sc["cases"].as_array().unwrap().iter().enumerate() {
+            let mut req = bases[case["base"].as_u64().unwrap() as usize].clone();
+            for (k, x) in case["override"].as_object().unwrap() {
+                if x.is_null() {
+                    req.as_object_mut().unwrap().remove(k);
+                } else {
+                    req[k] = x.clone();
+                }
+            }
+            let req: PlanRequest = serde_json::from_value(req).unwrap();
+            let mut resp = serde_json::to_value(planner.plan_request(&req).unwrap()).unwrap();
+            resp["compute_micros"] = json!(0);
+            assert_eq!(
+                digest(&resp),
+                case["response_sha256"],
+                "{id}: case {i} ({}) answers differently",
+                case["override"]
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 40, "{checked}");
+    for entry in doc["ids"].as_array().unwrap() {
+        let spec: ScenarioSpec = serde_json::from_value(entry["spec"].clone()).unwrap();
+        assert_eq!(Scenario::new(spec).unwrap().id, entry["id"]);
+    }
+}
