@@ -85,7 +85,7 @@ pub enum FovSpec {
 /// A scenario as clients send it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
-#[schema(examples(json!(paper_spec(10.0))))]
+#[schema(examples(json!(paper_spec(10.0)), json!(site_gates_spec())))]
 pub struct ScenarioSpec {
     /// Free-form label.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -103,8 +103,8 @@ pub struct ScenarioSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(exclusive_minimum = 0)]
     pub target_speed: Option<f64>,
-    /// Target sources.
-    #[schema(max_items = 64)]
+    /// Target sources (at least one).
+    #[schema(min_items = 1, max_items = 64)]
     pub sources: Vec<SourceSpec>,
     /// Default planning horizon T (1..=12, default 3).
     #[serde(default, skip_serializing_if = "Option::is_none")]

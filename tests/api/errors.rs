@@ -327,3 +327,127 @@ async fn invalid_plan_requests_are_422() {
         res.text().await.unwrap()
     );
 }
+
+/// `spec_rejected`, and the detail also states the bound.
+async fn spec_rejected_saying(
+    app: &TestApp,
+    edit: impl FnOnce(&mut Value),
+    field: &str,
+    bound: &str,
+) {
+    let mut spec = small_spec();
+    edit(&mut spec);
+    let res = app.post_json("/v1/scenarios", &spec).await;
+    let body = assert_problem(res, StatusCode::UNPROCESSABLE_ENTITY, field).await;
+    let detail = body["detail"].as_str().unwrap();
+    assert!(
+        detail.starts_with(&format!("{field}: ")) && detail.contains(bound),
+        "detail {detail:?} should name {field:?} and say {bound:?}"
+    );
+}
+
+#[tokio::test]
+async fn invalid_target_models_are_422() {
+    let app = spawn_app().await;
+    let class = |speed: f64, weight: f64| json!({"speed": speed, "weight": weight});
+    spec_rejected_saying(
+        &app,
+        |s| s["sources"][0]["speeds"] = json!([class(5.0, 1.0), class(9.0, 0.0)]),
+        "sources[0].speeds[1].weight",
+        "> 0, got 0",
+    )
+    .await;
+    spec_rejected_saying(
+        &app,
+        |s| s["sources"][1]["speeds"] = json!([class(5.0, -2.0)]),
+        "sources[1].speeds[0].weight",
+        "> 0, got -2",
+    )
+    .await;
+    spec_rejected_saying(
+        &app,
+        |s| s["sources"][0]["speeds"] = json!([class(0.0, 1.0)]),
+        "sources[0].speeds[0].speed",
+        "> 0",
+    )
+    .await;
+    spec_rejected_saying(
+        &app,
+        |s| s["sources"][0]["speeds"] = json!(vec![class(5.0, 1.0); 9]),
+        "sources[0].speeds",
+        "1 to 8 classes, got 9",
+    )
+    .await;
+    spec_rejected_saying(
+        &app,
+        |s| s["sources"][0]["speeds"] = json!([]),
+        "sources[0].speeds",
+        "1 to 8 classes, got 0",
+    )
+    .await;
+    for spread in [0.0, 200.0, -10.0] {
+        spec_rejected_saying(
+            &app,
+            |s| s["sources"][0]["spread"] = json!(spread),
+            "sources[0].spread",
+            "(0, 180]",
+        )
+        .await;
+    }
+    // Aimed away from the zone, and past its corner.
+    spec_rejected_saying(
+        &app,
+        |s| {
+            s["sources"][0]["direction"] = json!(180.0);
+            s["sources"][0]["spread"] = json!(30.0);
+        },
+        "sources[0]",
+        "enters the zone",
+    )
+    .await;
+    spec_rejected_saying(
+        &app,
+        |s| {
+            s["sources"][1]["direction"] = json!(30.0);
+            s["sources"][1]["spread"] = json!(10.0);
+        },
+        "sources[1]",
+        "enters the zone",
+    )
+    .await;
+    // A narrow cone around a heading that misses the zone.
+    spec_rejected_saying(
+        &app,
+        |s| {
+            s["sources"][0] =
+                json!({"x": -1.0, "y": -40.0, "rate": 1.0, "heading": "east", "spread": 20.0})
+        },
+        "sources[0]",
+        "enters the zone",
+    )
+    .await;
+    spec_rejected_saying(
+        &app,
+        |s| {
+            s.as_object_mut().unwrap().remove("target_speed");
+            s["sources"][0]["speeds"] = json!([class(4.0, 1.0)]);
+        },
+        "target_speed",
+        "sources[1] gives no speeds",
+    )
+    .await;
+    spec_rejected_saying(
+        &app,
+        |s| s["sources"] = json!([]),
+        "sources",
+        "at least one source",
+    )
+    .await;
+    // Every source with speeds: no target_speed needed.
+    let mut spec = small_spec();
+    spec.as_object_mut().unwrap().remove("target_speed");
+    spec["sources"][0]["speeds"] = json!([class(4.0, 1.0), class(12.0, 3.0)]);
+    spec["sources"][1]["speeds"] = json!([class(2.0, 1.0)]);
+    let res = app.post_json("/v1/scenarios", &spec).await;
+    assert_eq!(res.status(), StatusCode::CREATED);
+}

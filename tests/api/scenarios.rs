@@ -227,3 +227,88 @@ async fn builtins_cannot_be_deleted() {
         assert_eq!(res.status(), StatusCode::OK);
     }
 }
+
+/// A scenario with speed mixtures and cones registers with its canonical
+/// form (direction in [0, 360), a default spread dropped, no heading on a
+/// directed source), its statistics see nothing outside the cones, and it
+/// plans.
+#[tokio::test]
+async fn mixtures_and_cones_register_and_plan() {
+    let app = spawn_app().await;
+    let spec = json!({
+        "zone": {"width": 200.0, "height": 100.0}, "cell_size": 10.0,
+        "fov": {"shape": "square", "half_width": 15.0},
+        "sources": [
+            {"x": -1.0, "y": 20.0, "rate": 0.5, "heading": "east", "direction": -350.0,
+             "spread": 20.0, "speeds": [{"speed": 1.5, "weight": 3.0}, {"speed": 12.0, "weight": 1.0}]},
+            {"x": 150.0, "y": 101.0, "rate": 0.0, "spread": 180.0,
+             "speeds": [{"speed": 6.0, "weight": 1.0}]}
+        ]
+    });
+    let res = app.post_json("/v1/scenarios", &spec).await;
+    let created = json_body(res, StatusCode::CREATED).await;
+    let id = created["id"].as_str().unwrap().to_owned();
+    let canonical = &created["spec"];
+    assert!(canonical.get("target_speed").is_none());
+    assert_eq!(canonical["sources"][0]["direction"], 10.0);
+    assert!(canonical["sources"][0].get("heading").is_none());
+    assert_eq!(canonical["sources"][0]["spread"], 20.0);
+    assert!(canonical["sources"][1].get("spread").is_none());
+    assert_eq!(canonical["sources"][1]["heading"], "south");
+    // The canonical form is the same scenario.
+    let again = app.post_json("/v1/scenarios", canonical).await;
+    assert_eq!(json_body(again, StatusCode::OK).await["id"], id.as_str());
+
+    let stats = json_body(
+        app.get(&format!("/v1/scenarios/{id}/stats")).await,
+        StatusCode::OK,
+    )
+    .await;
+    let lambda = stats["lambda_hat"].as_array().unwrap();
+    let d_hat = stats["d_hat"].as_array().unwrap();
+    // Row 9, column 0 (the north-west corner) is outside the first cone (the
+    // second source emits nothing); row 2, column 5 is on the first cone's
+    // axis (y = 20 + x·tan 10°).
+    let at = |row: usize, col: usize| row * 20 + col;
+    assert_eq!(lambda[at(9, 0)], 0.0);
+    assert_eq!(d_hat[at(9, 0)], 0.0);
+    assert!(lambda[at(2, 5)].as_f64().unwrap() > 0.1);
+    assert!(d_hat[at(2, 5)].as_f64().unwrap() > 0.1);
+
+    let body = json!({"sensors": [{"id": "a", "x": 55, "y": 25}, {"id": "b", "x": 150, "y": 80}],
+                      "history": [[{"x": 45, "y": 25}, {"x": 150, "y": 70}]]});
+    for estimator in ["exact", "paper"] {
+        let mut body = body.clone();
+        body["estimator"] = json!(estimator);
+        let plan = json_body(
+            app.post_json(&format!("/v1/scenarios/{id}/plan"), &body)
+                .await,
+            StatusCode::OK,
+        )
+        .await;
+        assert_eq!(plan["plans"].as_array().unwrap().len(), 2);
+        let total = plan["expected_detections"].as_f64().unwrap();
+        assert!(total.is_finite() && total > 0.0, "{estimator}: {total}");
+    }
+}
+
+/// `site-gates` is served with its cones and speed classes.
+#[tokio::test]
+async fn site_gates_is_built_in() {
+    let app = spawn_app().await;
+    let body = json_body(app.get("/v1/scenarios/site-gates").await, StatusCode::OK).await;
+    assert_eq!(body["grid"], json!({"cols": 40, "rows": 30}));
+    let sources = body["spec"]["sources"].as_array().unwrap();
+    assert!(sources.iter().all(|s| s["speeds"].is_array()));
+    assert!(sources.iter().any(|s| s["direction"].is_number()));
+    let plan = json_body(
+        app.post_json(
+            "/v1/scenarios/site-gates/plan",
+            &json!({"sensors": [{"id": 1, "x": 100, "y": 150}]}),
+        )
+        .await,
+        StatusCode::OK,
+    )
+    .await;
+    assert_eq!(plan["plans"][0]["path"].as_array().unwrap().len(), 3);
+}
