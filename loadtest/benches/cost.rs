@@ -3,7 +3,8 @@
 //! of the history, each varied alone from the reference workload
 //! (`paper-v10`, 10 sensors, 16 steps of history, the targets they track,
 //! exact + priority, T = 3), and scenario precompute time against lattice
-//! size.
+//! size; and plan time on `site-gates` against the number of speed classes
+//! per source.
 //!
 //! Every request comes from a `vigil-sim` run ([`Workload`]); before timing,
 //! each answer is checked (one path of T legal moves per sensor). The
@@ -19,7 +20,10 @@ use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use vigil::planner::{PlanRequest, Planner, TargetIn};
-use vigil::scenario::{FovSpec, Scenario, ScenarioSpec, SourceSpec, ZoneSpec, builtins};
+use vigil::scenario::{
+    FovSpec, SITE_CYCLIST, SITE_VEHICLE, SITE_WALKER, Scenario, ScenarioSpec, SourceSpec,
+    SpeedSpec, ZoneSpec, builtins, site_gates_spec,
+};
 use vigil_loadtest::workload::Workload;
 
 /// Plans `req` once and checks the answer's shape.
@@ -206,5 +210,50 @@ fn precompute(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, horizon, sensors, targets, history, precompute);
+/// `site-gates` with every source's speed distribution replaced by `k`
+/// classes spread over the walkers' to the vehicles' speed (equal weights;
+/// k = 1 is the walkers' speed alone), cones and rates unchanged.
+fn site_with_classes(k: usize) -> Scenario {
+    let mut spec = site_gates_spec();
+    let speeds: Vec<f64> = match k {
+        1 => vec![SITE_WALKER],
+        2 => vec![SITE_WALKER, SITE_VEHICLE],
+        4 => vec![SITE_WALKER, SITE_CYCLIST, 8.0, SITE_VEHICLE],
+        _ => unreachable!("k in 1, 2, 4"),
+    };
+    for src in &mut spec.sources {
+        src.speeds = Some(
+            speeds
+                .iter()
+                .map(|&speed| SpeedSpec { speed, weight: 1.0 })
+                .collect(),
+        );
+    }
+    Scenario::new(spec).unwrap()
+}
+
+/// Plan time against the number of speed classes per source on
+/// `site-gates` (the reference workload's shape: 10 sensors, 16 steps of
+/// history, exact + priority, T = 3): a mixture of K speeds may cost up to
+/// K times one speed.
+fn speed_classes(c: &mut Criterion) {
+    let mut g = group(c, "plan_vs_speed_classes");
+    for k in [1, 2, 4] {
+        let planner = Planner::new(site_with_classes(k));
+        assert_eq!(planner.scenario.classes.len(), 4 * k);
+        let reqs = Workload::reference().requests(&planner, 4);
+        bench_requests(&mut g, &planner, k, &reqs);
+    }
+    g.finish();
+}
+
+criterion_group!(
+    benches,
+    horizon,
+    sensors,
+    targets,
+    history,
+    speed_classes,
+    precompute
+);
 criterion_main!(benches);
