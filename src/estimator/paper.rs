@@ -12,10 +12,14 @@ use crate::stats::{Stats, paper_statistical_part};
 ///   whose straight-line position at step `t` is inside `F_Pk`. At `Pk = Pi`
 ///   this is eq. (1)'s "seen now, minus the k that will have left".
 /// - statistical part at `Pi`: `λ̂_Pi·t − Σ_j λ̂_Pi,j Σ_{u=1..t} P(te_Pi,j < t−u)`
-///   (see [`paper_statistical_part`]).
+///   (see [`paper_statistical_part`]). With speed mixtures and cones the
+///   sum over sources `j` runs over target classes (source × speed): each
+///   class enters at its own rate `λ_j·w·θ_Pi,j/spread_j` and escapes after
+///   its own chord over its own speed.
 /// - eq. (2): `κ = |F_Pi ∩ F_Pk| / |F_Pk|` weighs that statistical part and
-///   `(1−κ)` weighs `d̂_Pk`, the stationary count, for the part of `F_Pk`
-///   the sensor cannot see; `κ = 1` at `Pi` gives eq. (1).
+///   `(1−κ)` weighs `d̂_Pk`, the stationary count (over every class and
+///   cone), for the part of `F_Pk` the sensor cannot see; `κ = 1` at `Pi`
+///   gives eq. (1).
 ///
 /// Coordination (step 6) multiplies by `1 − f`, `f` the fraction of `F_Pk`'s
 /// area covered by the excluded fields of view.
