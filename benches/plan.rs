@@ -49,7 +49,7 @@ fn reference_request(planner: &Planner, horizon: usize) -> PlanRequest {
     PlanRequest {
         sensors,
         targets,
-        horizon: Some(horizon),
+        horizon: Some(horizon.into()),
         ..PlanRequest::default()
     }
 }

@@ -14,7 +14,7 @@ use crate::estimator::{
     ElementaryGrid, Estimator, ExactEstimator, PaperEstimator, SourceRays, Target,
 };
 use crate::geometry::{Point, Region};
-use crate::scenario::{Cell, Scenario, ValidationError, check_horizon};
+use crate::scenario::{Cell, Integer, Scenario, ValidationError, check_horizon};
 use crate::stats::Stats;
 
 /// Most sensors in one request.
@@ -119,14 +119,14 @@ pub struct PlanRequest {
     #[serde(default)]
     #[schema(max_items = 20000)]
     pub targets: Vec<TargetIn>,
-    /// Sensors' positions 1, 2, … steps ago.
+    /// Sensors' positions 1, 2, … steps ago (at most 256 a step).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(max_items = 32)]
     pub history: Option<Vec<Vec<PositionIn>>>,
     /// Horizon T; the scenario's by default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(minimum = 1, maximum = 12)]
-    pub horizon: Option<usize>,
+    #[schema(value_type = Option<u32>, minimum = 1, maximum = 12)]
+    pub horizon: Option<Integer>,
     /// Estimator; `exact` by default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub estimator: Option<EstimatorKind>,
@@ -309,7 +309,7 @@ impl PlanInput {
                     .collect::<Result<Vec<_>, _>>()?,
             );
         }
-        let horizon = check_horizon("horizon", req.horizon.unwrap_or(s.horizon))?;
+        let horizon = check_horizon("horizon", req.horizon.as_ref(), s.horizon)?;
         Ok(PlanInput {
             ids,
             starts,

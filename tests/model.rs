@@ -405,7 +405,7 @@ fn iterated_is_never_below_priority() {
             for estimator in [EstimatorKind::Exact, EstimatorKind::Paper] {
                 let mut req = snapshot_request(&planner.scenario, 4 + (seed as usize % 7), seed);
                 req.estimator = Some(estimator);
-                req.horizon = Some(1 + seed as usize % 4);
+                req.horizon = Some((1 + seed as usize % 4).into());
                 let total = |c: Coordination| {
                     let mut r = req.clone();
                     r.coordination = Some(c);
@@ -468,7 +468,7 @@ fn exact_total_counts_distinct_known_targets() {
                 vy: 0.0,
             })
             .collect(),
-        horizon: Some(2),
+        horizon: Some(2.into()),
         ..PlanRequest::default()
     };
     for c in [
@@ -650,7 +650,7 @@ fn mixture_spec(fov: FovSpec) -> ScenarioSpec {
                 ..SourceSpec::at(-20.0, 320.0, 0.3)
             },
         ],
-        horizon: Some(3),
+        horizon: Some(3.into()),
     }
 }
 

@@ -29,7 +29,7 @@ use vigil_loadtest::workload::Workload;
 /// Plans `req` once and checks the answer's shape.
 fn checked(planner: &Planner, req: &PlanRequest) {
     let resp = planner.plan_request(req).unwrap();
-    let horizon = req.horizon.unwrap();
+    let horizon = req.horizon.as_ref().and_then(|h| h.get()).unwrap() as usize;
     assert_eq!(resp.plans.len(), req.sensors.len());
     for p in &resp.plans {
         assert_eq!(p.path.len(), horizon);
@@ -81,7 +81,7 @@ fn horizon(c: &mut Criterion) {
         let reqs: Vec<PlanRequest> = base
             .iter()
             .map(|r| PlanRequest {
-                horizon: Some(t),
+                horizon: Some(t.into()),
                 ..r.clone()
             })
             .collect();
@@ -178,7 +178,7 @@ pub fn lattice(side: usize) -> Scenario {
             src(w / 3.0, w + 1.0),
             src(2.0 * w / 3.0, w + 1.0),
         ],
-        horizon: Some(3),
+        horizon: Some(3.into()),
     })
     .unwrap()
 }

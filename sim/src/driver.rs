@@ -221,7 +221,7 @@ impl Sim {
             sensors,
             targets,
             history: (!history.is_empty()).then_some(history),
-            horizon,
+            horizon: horizon.map(Into::into),
             estimator: settings.map(|p| p.estimator),
             coordination: settings.map(|p| p.coordination),
             observed: settings.map(|p| p.observed),

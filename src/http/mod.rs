@@ -16,6 +16,29 @@
 //! | GET | `/v1/scenarios/{id}/stats` | 200 per-cell statistics |
 //! | POST | `/v1/scenarios/{id}/plan` | 200 [`PlanResponse`](crate::planner::PlanResponse) |
 
+/// The rules of a scenario spec that no JSON Schema can state, for the
+/// operations' descriptions (the fuzzer's list is `.ci/schemathesis/hooks.py`).
+macro_rules! spec_rules {
+    () => {
+        " Rules no schema can state (each a 422 whose `detail` names the field): the zone's \
+        width and height are whole multiples of `cell_size`, and the lattice has at most \
+        4,000,000 cells; every source lies strictly outside the zone; a source without \
+        `direction` is beside exactly one edge of the zone or gives a `heading` whose \
+        half-plane holds the zone; some direction of each source's cone enters the zone; \
+        `target_speed` is required when some source gives no `speeds`; a source's weights sum \
+        to a finite number; and Σ rate·diagonal/speed over the speed classes is at most 1e9 \
+        (the statistics stay finite)."
+    };
+}
+
+/// The rules of a plan request that no JSON Schema can state.
+macro_rules! plan_rules {
+    () => {
+        " Rules no schema can state (each a 422 whose `detail` names the field): every sensor \
+        and history position lies in the scenario's zone, and sensor ids are unique."
+    };
+}
+
 pub mod cache;
 pub mod config;
 pub mod error;

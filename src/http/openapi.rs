@@ -18,8 +18,10 @@ use utoipa::{Modify, OpenApi, ToResponse, ToSchema};
 use super::error::{ApiError, Problem};
 use super::{health, middleware, plan, scenarios};
 use crate::coordination::Coordination;
-use crate::planner::{EstimatorKind, Observed, PositionIn, SensorIn, TargetIn};
-use crate::scenario::{ScenarioSpec, ValidationError};
+use crate::planner::{
+    EstimatorKind, MAX_HISTORY_POSITIONS, Observed, PositionIn, SensorIn, TargetIn,
+};
+use crate::scenario::{Integer, ScenarioSpec, ValidationError};
 
 /// Description of the whole API, the `info.description` of the document.
 const DESCRIPTION: &str = "\
@@ -31,7 +33,8 @@ A **scenario** is the model: a rectangular zone divided into square cells, \
 point sources of targets outside it, the sensors' field of view and the \
 targets' speed. Registering one precomputes its per-cell statistics; the \
 built-in scenarios `paper-v10` and `paper-v15` are the paper's setting with \
-target speeds 10 and 15. A **plan** request gives the sensors' positions and \
+target speeds 10 and 15, and `site-gates` a site whose walkers, cyclists and \
+vehicles come through directed gates. A **plan** request gives the sensors' positions and \
 the targets they report now, and gets back coordinated T-step paths.
 
 Every error is an RFC 9457 problem (`application/problem+json`, schema \
@@ -74,7 +77,7 @@ Every error is an RFC 9457 problem (`application/problem+json`, schema \
             Timeout,
         )
     ),
-    modifiers(&V1Stack),
+    modifiers(&V1Stack, &Closed),
     tags(
         (name = "health", description = "Liveness."),
         (name = "scenarios", description = "Register, read and delete scenarios."),
@@ -184,41 +187,103 @@ pub async fn serve() -> impl IntoResponse {
     )
 }
 
+/// The fields of `POST /v1/scenarios/{id}/plan`'s body ([`PlanRequest`]
+/// for the schema) with one more, required: the two shapes of the body of
+/// `POST /v1/plan`.
+macro_rules! plan_request_with {
+    ($(#[$doc:meta])* $name:ident, $(#[$field_doc:meta])* $field:ident: $ty:ty) => {
+        $(#[$doc])*
+        #[derive(Debug, ToSchema)]
+        #[serde(deny_unknown_fields)]
+        pub struct $name {
+            $(#[$field_doc])*
+            pub $field: $ty,
+            /// Sensors now.
+            #[schema(min_items = 1, max_items = 256)]
+            pub sensors: Vec<SensorIn>,
+            /// Targets reported now.
+            #[serde(default)]
+            #[schema(max_items = 20000)]
+            pub targets: Vec<TargetIn>,
+            /// Sensors' positions 1, 2, … steps ago (at most 256 a step).
+            #[schema(max_items = 32)]
+            pub history: Option<Vec<Vec<PositionIn>>>,
+            /// Horizon T; the scenario's by default.
+            #[schema(value_type = Option<u32>, minimum = 1, maximum = 12)]
+            pub horizon: Option<Integer>,
+            /// Estimator; `exact` by default.
+            pub estimator: Option<EstimatorKind>,
+            /// Coordination; `priority` by default.
+            pub coordination: Option<Coordination>,
+            /// What the reported targets cover; `sensors` by default.
+            pub observed: Option<Observed>,
+            /// Include the search values in the response.
+            pub explain: Option<bool>,
+        }
+    };
+}
+
+plan_request_with!(
+    /// `POST /v1/plan` naming its scenario.
+    PlanRequestById,
+    /// Id of a registered scenario, or of one sent inline before.
+    #[schema(example = "paper-v10")]
+    scenario_id: String
+);
+
+plan_request_with!(
+    /// `POST /v1/plan` carrying its scenario.
+    PlanRequestWithScenario,
+    /// The scenario itself; precomputed on first use and cached.
+    scenario: ScenarioSpec
+);
+
 /// Body of `POST /v1/plan`: the body of `POST /v1/scenarios/{id}/plan` plus
 /// exactly one of `scenario_id` and `scenario`.
 #[derive(Debug, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct InlinePlanRequest {
-    /// Id of a registered scenario, or of one sent inline before.
-    #[schema(example = "paper-v10")]
-    pub scenario_id: Option<String>,
-    /// The scenario itself; precomputed on first use and cached.
-    pub scenario: Option<ScenarioSpec>,
-    /// Sensors now.
-    #[schema(min_items = 1, max_items = 256)]
-    pub sensors: Vec<SensorIn>,
-    /// Targets reported now.
-    #[serde(default)]
-    #[schema(max_items = 20000)]
-    pub targets: Vec<TargetIn>,
-    /// Sensors' positions 1, 2, … steps ago.
-    #[schema(max_items = 32)]
-    pub history: Option<Vec<Vec<PositionIn>>>,
-    /// Horizon T; the scenario's by default.
-    #[schema(minimum = 1, maximum = 12)]
-    pub horizon: Option<usize>,
-    /// Estimator; `exact` by default.
-    pub estimator: Option<EstimatorKind>,
-    /// Coordination; `priority` by default.
-    pub coordination: Option<Coordination>,
-    /// What the reported targets cover; `sensors` by default.
-    pub observed: Option<Observed>,
-    /// Include the search values in the response.
-    pub explain: Option<bool>,
+#[serde(untagged)]
+pub enum InlinePlanRequest {
+    /// The scenario by id.
+    ById(PlanRequestById),
+    /// The scenario inline.
+    WithScenario(PlanRequestWithScenario),
+}
+
+/// What the derives cannot say and the server enforces: the variants of
+/// `FovSpec` admit no other fields, and a history step holds at most
+/// [`MAX_HISTORY_POSITIONS`] positions.
+struct Closed;
+
+impl Modify for Closed {
+    fn modify(&self, doc: &mut utoipa::openapi::OpenApi) {
+        use utoipa::openapi::schema::{AdditionalProperties, ArrayItems, Schema};
+        let Some(components) = doc.components.as_mut() else {
+            return;
+        };
+        if let Some(RefOr::T(Schema::OneOf(one_of))) = components.schemas.get_mut("FovSpec") {
+            for item in &mut one_of.items {
+                if let RefOr::T(Schema::Object(variant)) = item {
+                    variant.additional_properties =
+                        Some(Box::new(AdditionalProperties::FreeForm(false)));
+                }
+            }
+        }
+        for name in ["PlanRequest", "PlanRequestById", "PlanRequestWithScenario"] {
+            let Some(RefOr::T(Schema::Object(object))) = components.schemas.get_mut(name) else {
+                continue;
+            };
+            if let Some(RefOr::T(Schema::Array(history))) = object.properties.get_mut("history")
+                && let ArrayItems::RefOrSchema(step) = &mut history.items
+                && let RefOr::T(Schema::Array(step)) = step.as_mut()
+            {
+                step.max_items = Some(MAX_HISTORY_POSITIONS);
+            }
+        }
+    }
 }
 
 /// Description of the `{id}` path parameter.
-pub const SCENARIO_ID: &str = "Scenario id: a built-in (`paper-v10`, `paper-v15`) or one returned by \
+pub const SCENARIO_ID: &str = "Scenario id: a built-in (`paper-v10`, `paper-v15`, `site-gates`) or one returned by \
     `POST /v1/scenarios`.";
 
 fn problem(e: ApiError) -> Problem {

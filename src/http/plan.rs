@@ -20,10 +20,10 @@ use crate::scenario::{Scenario, ScenarioSpec};
     operation_id = "planScenario",
     tag = "planning",
     summary = "Plan the sensors' next T steps",
-    description = "Plans coordinated T-step paths for the sensors that maximise the expected \
+    description = concat!("Plans coordinated T-step paths for the sensors that maximise the expected \
         number of distinct targets detected, given the targets reported now (and optionally the \
         sensors' past positions). Positions are snapped to the scenario's lattice. The scenario \
-        is looked up before the body is read, so an unknown id is 404 whatever the body.",
+        is looked up before the body is read, so an unknown id is 404 whatever the body.", plan_rules!()),
     params(("id" = String, Path, description = doc::SCENARIO_ID, example = "paper-v10")),
     request_body(content = PlanRequest, description = "Sensors, targets and options.",
         examples(
@@ -66,10 +66,10 @@ pub async fn plan(
     operation_id = "plan",
     tag = "planning",
     summary = "Plan in a scenario named or sent inline",
-    description = "The same planning as `POST /v1/scenarios/{id}/plan`, with the scenario in the \
+    description = concat!("The same planning as `POST /v1/scenarios/{id}/plan`, with the scenario in the \
         body: either `scenario_id` (a registered scenario, or one sent inline before) or \
         `scenario` (a spec, precomputed on first use and kept in a memory-bounded LRU cache, \
-        not registered). Exactly one of the two is required.",
+        not registered). Exactly one of the two is required.", plan_rules!(), spec_rules!()),
     request_body(content = doc::InlinePlanRequest, description = "Scenario, sensors, targets and options.",
         examples(
             ("by-id" = (summary = "paper-v10 by id", value = json!(examples::plan_request_by_id()))),

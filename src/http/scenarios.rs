@@ -146,9 +146,9 @@ pub async fn list(State(state): State<AppState>) -> Json<ScenarioList> {
     operation_id = "createScenario",
     tag = "scenarios",
     summary = "Register a scenario",
-    description = "Validates the spec, precomputes its per-cell statistics and registers it under \
+    description = concat!("Validates the spec, precomputes its per-cell statistics and registers it under \
         an id derived from the canonical spec (`s-` and 16 hex digits), so posting the same spec \
-        again is idempotent: 201 the first time, 200 with the registered scenario after.",
+        again is idempotent: 201 the first time, 200 with the registered scenario after.", spec_rules!()),
     request_body(content = ScenarioSpec, description = "The scenario.",
         example = json!(examples::small_spec())),
     responses(

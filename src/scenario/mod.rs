@@ -23,6 +23,10 @@ pub const MAX_HORIZON: usize = 12;
 pub const MAX_CELLS: usize = 4_000_000;
 /// Largest number of sources in a scenario.
 pub const MAX_SOURCES: usize = 64;
+/// Largest bound on the zone's population accepted: `Σ rate·diagonal/speed`
+/// over the target classes (the most targets the zone could hold at once if
+/// every one crossed its full diagonal). Keeps every statistic finite.
+pub const MAX_POPULATION: f64 = 1e9;
 /// Horizon used when a spec does not give one.
 pub const DEFAULT_HORIZON: usize = 3;
 
@@ -108,8 +112,8 @@ pub struct ScenarioSpec {
     pub sources: Vec<SourceSpec>,
     /// Default planning horizon T (1..=12, default 3).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(minimum = 1, maximum = 12)]
-    pub horizon: Option<usize>,
+    #[schema(value_type = Option<u32>, minimum = 1, maximum = 12)]
+    pub horizon: Option<Integer>,
 }
 
 /// A lattice cell, `col` east and `row` north.
@@ -161,16 +165,71 @@ fn finite_positive(field: &str, v: f64) -> Result<f64, ValidationError> {
     }
 }
 
-/// Checks a horizon against `1..=MAX_HORIZON`.
-pub fn check_horizon(field: &str, h: usize) -> Result<usize, ValidationError> {
-    if (1..=MAX_HORIZON).contains(&h) {
-        Ok(h)
-    } else {
-        Err(ValidationError::new(
-            field,
-            format!("must be in 1..={MAX_HORIZON}, got {h}"),
-        ))
+/// An integer field as JSON carries it. JSON has one number type, so `4.0`
+/// is the integer 4 (as JSON Schema's `integer` also says); a number with a
+/// fraction, or out of range, is kept as sent and refused by validation with
+/// a 422 that names the field.
+///
+/// Fields of this type say `#[schema(value_type = …)]` with an integer type,
+/// so the document states `integer` and the field's bounds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(transparent)]
+pub struct Integer(serde_json::Number);
+
+impl Integer {
+    /// The value, when it is a whole number in `0..=u64::MAX`.
+    pub fn get(&self) -> Option<u64> {
+        if let Some(v) = self.0.as_u64() {
+            return Some(v);
+        }
+        // 2^64 is exactly representable; every whole f64 below it fits.
+        let v = self.0.as_f64()?;
+        (v.fract() == 0.0 && (0.0..18_446_744_073_709_551_616.0).contains(&v)).then_some(v as u64)
     }
+
+    /// The value if it lies in `range`, else a validation error for
+    /// `field` that states the range.
+    pub fn check(
+        &self,
+        field: &str,
+        range: std::ops::RangeInclusive<usize>,
+    ) -> Result<usize, ValidationError> {
+        self.get()
+            .and_then(|v| usize::try_from(v).ok())
+            .filter(|v| range.contains(v))
+            .ok_or_else(|| {
+                ValidationError::new(
+                    field,
+                    format!(
+                        "must be an integer in {}..={}, got {}",
+                        range.start(),
+                        range.end(),
+                        self.0
+                    ),
+                )
+            })
+    }
+}
+
+impl From<usize> for Integer {
+    fn from(v: usize) -> Self {
+        Integer(serde_json::Number::from(v as u64))
+    }
+}
+
+impl std::fmt::Display for Integer {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
+/// Checks a horizon against `1..=MAX_HORIZON`; `None` is `default`.
+pub fn check_horizon(
+    field: &str,
+    h: Option<&Integer>,
+    default: usize,
+) -> Result<usize, ValidationError> {
+    h.map_or(Ok(default), |h| h.check(field, 1..=MAX_HORIZON))
 }
 
 impl Scenario {
@@ -258,10 +317,20 @@ impl Scenario {
             sources.push(v.source);
             canonical_sources.push(v.canonical);
         }
-        let horizon = check_horizon("horizon", spec.horizon.unwrap_or(DEFAULT_HORIZON))?;
+        let diagonal = width.hypot(height);
+        let population: f64 = classes.iter().map(|c| c.rate * diagonal / c.speed).sum();
+        if population.is_nan() || population > MAX_POPULATION {
+            return Err(ValidationError::new(
+                "sources",
+                format!(
+                    "too many targets: Σ rate·diagonal/speed over the speed classes is {population:e}, at most {MAX_POPULATION:e}"
+                ),
+            ));
+        }
+        let horizon = check_horizon("horizon", spec.horizon.as_ref(), DEFAULT_HORIZON)?;
         let canonical = ScenarioSpec {
             sources: canonical_sources,
-            horizon: Some(horizon),
+            horizon: Some(horizon.into()),
             ..spec
         };
         let id = match id {
@@ -433,7 +502,7 @@ pub fn paper_spec(target_speed: f64) -> ScenarioSpec {
             src(100.0, 301.0),
             src(200.0, 301.0),
         ],
-        horizon: Some(3),
+        horizon: Some(3.into()),
     }
 }
 
@@ -492,7 +561,7 @@ pub fn site_gates_spec() -> ScenarioSpec {
                 ..SourceSpec::at(250.0, 301.0, 0.03)
             },
         ],
-        horizon: Some(3),
+        horizon: Some(3.into()),
     }
 }
 
@@ -537,7 +606,7 @@ mod tests {
         s.sources[0].heading = Some(Heading::West);
         assert_eq!(Scenario::new(s).unwrap_err().field, "sources[0].heading");
         let mut s = paper_spec(10.0);
-        s.horizon = Some(13);
+        s.horizon = Some(13.into());
         assert_eq!(Scenario::new(s).unwrap_err().field, "horizon");
         let mut s = paper_spec(10.0);
         s.target_speed = Some(f64::NAN);

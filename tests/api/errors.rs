@@ -50,7 +50,7 @@ async fn missing_fields_and_wrong_types_are_400() {
         ),
         (
             "/v1/scenarios/paper-v10/plan",
-            json!({"sensors": [], "horizon": -1}),
+            json!({"sensors": [], "horizon": "three"}),
             "horizon",
         ),
         (
@@ -284,6 +284,10 @@ async fn invalid_plan_requests_are_422() {
     plan_rejected(&app, |r| r["sensors"] = sensors(257), "sensors").await;
     plan_rejected(&app, |r| r["horizon"] = json!(0), "horizon").await;
     plan_rejected(&app, |r| r["horizon"] = json!(13), "horizon").await;
+    // JSON has one number type: a fraction or a negative is no horizon.
+    plan_rejected(&app, |r| r["horizon"] = json!(4.5), "horizon").await;
+    plan_rejected(&app, |r| r["horizon"] = json!(-1), "horizon").await;
+    plan_rejected(&app, |r| r["horizon"] = json!(1e30), "horizon").await;
     plan_rejected(
         &app,
         |r| {
@@ -450,4 +454,65 @@ async fn invalid_target_models_are_422() {
     spec["sources"][1]["speeds"] = json!([class(2.0, 1.0)]);
     let res = app.post_json("/v1/scenarios", &spec).await;
     assert_eq!(res.status(), StatusCode::CREATED);
+}
+
+/// An integral float is the integer it equals, for every integer field
+/// (JSON Schema's `integer` says the same): `4.0` is horizon 4.
+#[tokio::test]
+async fn integral_floats_are_integers() {
+    let app = spawn_app().await;
+    let mut req = plan_request();
+    req["horizon"] = json!(4.0);
+    let res = app.plan(&req).await;
+    assert_eq!(res.status(), StatusCode::OK);
+    let body: Value = res.json().await.unwrap();
+    assert_eq!(body["horizon"], 4);
+    assert_eq!(body["plans"][0]["path"].as_array().unwrap().len(), 4);
+    let mut spec = small_spec();
+    spec["horizon"] = json!(5.0);
+    let res = app.post_json("/v1/scenarios", &spec).await;
+    assert_eq!(res.status(), StatusCode::CREATED);
+    let body: Value = res.json().await.unwrap();
+    // The canonical spec holds the integer, so `5.0` and `5` are one scenario.
+    assert_eq!(body["spec"]["horizon"], 5);
+    spec["horizon"] = json!(5);
+    let again = app.post_json("/v1/scenarios", &spec).await;
+    assert_eq!(again.status(), StatusCode::OK);
+    spec["horizon"] = json!(5.5);
+    spec_rejected_saying(
+        &app,
+        |s| *s = spec.clone(),
+        "horizon",
+        "integer in 1..=12, got 5.5",
+    )
+    .await;
+}
+
+/// Speeds so slow, or rates so high, that the statistics would overflow are
+/// refused: found by the OpenAPI fuzzer (`target_speed` 5e-324 gave `null`
+/// statistics).
+#[tokio::test]
+async fn overflowing_target_models_are_422() {
+    let app = spawn_app().await;
+    spec_rejected_saying(
+        &app,
+        |s| s["target_speed"] = json!(5e-324),
+        "sources",
+        "too many targets",
+    )
+    .await;
+    spec_rejected_saying(
+        &app,
+        |s| s["sources"][0]["rate"] = json!(1e300),
+        "sources",
+        "at most 1e9",
+    )
+    .await;
+    spec_rejected_saying(
+        &app,
+        |s| s["sources"][1]["speeds"] = json!([{"speed": 1e-300, "weight": 1.0}]),
+        "sources",
+        "too many targets",
+    )
+    .await;
 }

@@ -371,7 +371,9 @@ async fn every_documented_operation_is_served_as_documented() {
     }
 }
 
-/// `POST /v1/plan`'s doc-only body schema lists `PlanRequest`'s fields.
+/// `POST /v1/plan`'s doc-only body schema is one of two objects, each
+/// `PlanRequest`'s fields and one more, required: `scenario_id` or
+/// `scenario`. A body with both or neither matches neither.
 #[test]
 fn inline_plan_request_extends_plan_request() {
     let doc = document();
@@ -386,13 +388,48 @@ fn inline_plan_request_extends_plan_request() {
         f.sort();
         f
     };
-    let mut expected = fields("PlanRequest");
-    expected.extend(["scenario".to_owned(), "scenario_id".to_owned()]);
-    expected.sort();
-    assert_eq!(fields("InlinePlanRequest"), expected);
+    let refs: Vec<&str> = schemas["InlinePlanRequest"]["oneOf"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["$ref"].as_str().unwrap())
+        .collect();
     assert_eq!(
-        schemas["InlinePlanRequest"]["required"],
-        schemas["PlanRequest"]["required"]
+        refs,
+        [
+            "#/components/schemas/PlanRequestById",
+            "#/components/schemas/PlanRequestWithScenario"
+        ]
+    );
+    for (name, extra) in [
+        ("PlanRequestById", "scenario_id"),
+        ("PlanRequestWithScenario", "scenario"),
+    ] {
+        let mut expected = fields("PlanRequest");
+        expected.push(extra.to_owned());
+        expected.sort();
+        assert_eq!(fields(name), expected, "{name}");
+        let mut required = schemas["PlanRequest"]["required"]
+            .as_array()
+            .unwrap()
+            .clone();
+        required.insert(0, Value::from(extra));
+        assert_eq!(schemas[name]["required"], Value::Array(required), "{name}");
+        assert_eq!(schemas[name]["additionalProperties"], false, "{name}");
+    }
+    let checker = Checker { doc: &doc };
+    let body = |v: Value| {
+        let schema = serde_json::json!({"$ref": "#/components/schemas/InlinePlanRequest"});
+        checker.check(&schema, &v, "$")
+    };
+    let sensors = serde_json::json!([{"id": "a", "x": 1.0, "y": 2.0}]);
+    let spec = serde_json::to_value(vigil::scenario::paper_spec(10.0)).unwrap();
+    assert!(body(serde_json::json!({"scenario_id": "paper-v10", "sensors": sensors})).is_ok());
+    assert!(body(serde_json::json!({"scenario": spec, "sensors": sensors})).is_ok());
+    assert!(body(serde_json::json!({"sensors": sensors})).is_err());
+    assert!(
+        body(serde_json::json!({"scenario_id": "paper-v10", "scenario": spec, "sensors": sensors}))
+            .is_err()
     );
 }
 
@@ -492,18 +529,33 @@ fn every_routed_path_is_documented() {
 /// The bounds written into the schemas are the code's constants.
 #[test]
 fn schema_bounds_are_the_code_limits() {
-    use vigil::planner::{MAX_HISTORY_STEPS, MAX_SENSORS, MAX_TARGETS};
-    use vigil::scenario::{MAX_HORIZON, MAX_SOURCES};
+    use vigil::planner::{MAX_HISTORY_POSITIONS, MAX_HISTORY_STEPS, MAX_SENSORS, MAX_TARGETS};
+    use vigil::scenario::{MAX_HORIZON, MAX_SOURCES, MAX_SPEED_CLASSES};
     let doc = document();
     let schemas = &doc["components"]["schemas"];
-    for request in ["PlanRequest", "InlinePlanRequest"] {
+    for request in ["PlanRequest", "PlanRequestById", "PlanRequestWithScenario"] {
         let p = &schemas[request]["properties"];
         assert_eq!(p["sensors"]["maxItems"], MAX_SENSORS, "{request}");
+        assert_eq!(p["sensors"]["minItems"], 1, "{request}");
         assert_eq!(p["targets"]["maxItems"], MAX_TARGETS, "{request}");
         assert_eq!(p["history"]["maxItems"], MAX_HISTORY_STEPS, "{request}");
+        assert_eq!(
+            p["history"]["items"]["maxItems"], MAX_HISTORY_POSITIONS,
+            "{request}"
+        );
         assert_eq!(p["horizon"]["maximum"], MAX_HORIZON, "{request}");
+        assert_eq!(p["horizon"]["minimum"], 1, "{request}");
+        assert_eq!(p["horizon"]["type"], serde_json::json!(["integer", "null"]));
     }
     let spec = &schemas["ScenarioSpec"]["properties"];
     assert_eq!(spec["sources"]["maxItems"], MAX_SOURCES);
+    assert_eq!(spec["sources"]["minItems"], 1);
     assert_eq!(spec["horizon"]["maximum"], MAX_HORIZON);
+    let source = &schemas["SourceSpec"]["properties"];
+    assert_eq!(source["speeds"]["maxItems"], MAX_SPEED_CLASSES);
+    assert_eq!(source["spread"]["maximum"], 180);
+    // The variants of a field of view take no other fields.
+    for variant in schemas["FovSpec"]["oneOf"].as_array().unwrap() {
+        assert_eq!(variant["additionalProperties"], false);
+    }
 }

@@ -1,0 +1,83 @@
+"""Schemathesis hooks for Vigil: the one place that lists the rules of the
+API that no JSON Schema can state, each with its reason.
+
+The `positive_data_acceptance` check (a request the document calls valid must
+not be refused) is replaced by `schema_valid_requests_are_accepted`, which is
+the same check except that a 422 whose problem `detail` matches one of the
+rules below is accepted: the request was schema-valid but broke a documented
+rule that the schema cannot express. Everything else (any 5xx, a status,
+content type or body the document does not describe, a schema-invalid
+request accepted) is checked by Schemathesis's own checks.
+"""
+
+import re
+
+import schemathesis
+from schemathesis.specs.openapi.checks import positive_data_acceptance
+
+# (pattern on the problem's `detail`, why no schema can state the rule).
+# Details start with the field's JSON path; `scenario.` prefixes the fields
+# of a scenario sent inline to `POST /v1/plan`.
+UNSCHEMATISABLE = [
+    (
+        r"^(scenario\.)?zone\.(width|height): .* is not a whole multiple of cell_size",
+        "a relation between two numbers (the zone's extent and the cell size)",
+    ),
+    (
+        r"^(scenario\.)?(zone\.(width|height)|cell_size): (the lattice|.*cells)",
+        "a bound on a product of three numbers (width / cell_size × height / cell_size)",
+    ),
+    (
+        r"^(scenario\.)?sources\[\d+\]: \(.*\) is inside the zone",
+        "a source's position relative to the zone's extent, given in another field",
+    ),
+    (
+        r"^(scenario\.)?sources\[\d+\]\.heading: (required|.* does not face the zone)",
+        "geometry: whether the source is beside one edge, and which half-plane holds the zone",
+    ),
+    (
+        r"^(scenario\.)?sources\[\d+\]: no takeoff direction .* enters the zone",
+        "geometry: whether the cone (direction, spread, position) meets the zone",
+    ),
+    (
+        r"^(scenario\.)?sources\[\d+\]\.speeds: the weights' sum must be finite",
+        "a bound on a sum of array items",
+    ),
+    (
+        r"^(scenario\.)?sources: too many targets: ",
+        "a bound on a sum over the sources' classes of rate × zone diagonal / speed",
+    ),
+    (
+        r"^(scenario\.)?target_speed: required: sources\[\d+\] gives no speeds",
+        "required only when some array item lacks a field",
+    ),
+    (
+        r"^(sensors\[\d+\]|history\[\d+\]\[\d+\]): \(.*\) is outside the zone",
+        "a position must lie in the zone of the scenario named by the path or body",
+    ),
+    (
+        r"^sensors\[\d+\]\.id: duplicate sensor id",
+        "uniqueness of one property across array items (uniqueItems compares whole items)",
+    ),
+]
+
+_RULES = [re.compile(pattern) for pattern, _ in UNSCHEMATISABLE]
+
+
+def documented_refusal(detail: str) -> bool:
+    """True when a 422's detail is one of the rules above."""
+    return any(rule.search(detail) for rule in _RULES)
+
+
+@schemathesis.check
+def schema_valid_requests_are_accepted(ctx, response, case):
+    """A schema-valid request is not refused, unless for a rule listed in
+    UNSCHEMATISABLE."""
+    if response.status_code == 422:
+        try:
+            detail = response.json().get("detail", "")
+        except ValueError:
+            detail = ""
+        if isinstance(detail, str) and documented_refusal(detail):
+            return None
+    return positive_data_acceptance(ctx, response, case)
