@@ -399,26 +399,18 @@ async fn invalid_target_models_are_422() {
         .await;
     }
     // Aimed away from the zone, and past its corner.
-    spec_rejected_saying(
-        &app,
-        |s| {
-            s["sources"][0]["direction"] = json!(180.0);
-            s["sources"][0]["spread"] = json!(30.0);
-        },
-        "sources[0]",
-        "enters the zone",
-    )
-    .await;
-    spec_rejected_saying(
-        &app,
-        |s| {
-            s["sources"][1]["direction"] = json!(30.0);
-            s["sources"][1]["spread"] = json!(10.0);
-        },
-        "sources[1]",
-        "enters the zone",
-    )
-    .await;
+    for (i, direction, spread) in [(0, 180.0, 30.0), (1, 30.0, 10.0)] {
+        spec_rejected_saying(
+            &app,
+            |s| {
+                s["sources"][i]["direction"] = json!(direction);
+                s["sources"][i]["spread"] = json!(spread);
+            },
+            &format!("sources[{i}]"),
+            "enters the zone",
+        )
+        .await;
+    }
     // A narrow cone around a heading that misses the zone.
     spec_rejected_saying(
         &app,
