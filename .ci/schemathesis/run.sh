@@ -14,7 +14,8 @@ cd "$(dirname "$0")/../.."
 EXAMPLES="${EXAMPLES:-30}"
 MAX_TIME="${MAX_TIME:-180}"
 SEED="${SEED:-20261123}"
-VENV="${VENV:-target/schemathesis-venv}"
+TARGET="${CARGO_TARGET_DIR:-target}"
+VENV="${VENV:-$TARGET/schemathesis-venv}"
 HOOKS="${HOOKS:-.ci/schemathesis/hooks.py}"
 
 if [ ! -x "$VENV/bin/schemathesis" ]; then
@@ -27,7 +28,7 @@ cargo build --release --bin vigil-server
 data="$(mktemp -d)"
 log="$data/server.log"
 # Port 0: the server picks a free port and logs it.
-VIGIL_DATA_DIR="$data/store" target/release/vigil-server --bind 127.0.0.1:0 >"$log" 2>&1 &
+VIGIL_DATA_DIR="$data/store" "$TARGET/release/vigil-server" --bind 127.0.0.1:0 >"$log" 2>&1 &
 server=$!
 trap 'kill "$server" 2>/dev/null || true; wait "$server" 2>/dev/null || true; rm -rf "$data"' EXIT
 
