@@ -34,7 +34,8 @@ def shown(text: str) -> list[str]:
     prose = re.sub(r"```.*?```", "", text, flags=re.S)
     for span in re.findall(r"`([^`]+)`", prose):
         span = " ".join(span.split())
-        if START.match(span):
+        # A span with an ellipsis names a kind of command, not one to run.
+        if START.match(span) and "…" not in span:
             found.append(span)
     return found
 
