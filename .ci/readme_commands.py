@@ -34,7 +34,8 @@ def shown(text: str) -> list[str]:
     prose = re.sub(r"```.*?```", "", text, flags=re.S)
     for span in re.findall(r"`([^`]+)`", prose):
         span = " ".join(span.split())
-        if START.match(span):
+        # Prose about commands ("every `cargo …` command") is no command.
+        if START.match(span) and "…" not in span.split():
             found.append(span)
     return found
 
