@@ -48,6 +48,21 @@ pub fn grid_starts(s: &Scenario, n: usize) -> Vec<Cell> {
         .collect()
 }
 
+/// What the sensors know of a target in the zone.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TargetStatus {
+    /// Inside some sensor's field of view now.
+    Detected,
+    /// Not in view now, but seen within the history window: the planner
+    /// policies report it (a track).
+    Tracked,
+    /// Seen once, longer ago than the history window: no longer reported.
+    Lost,
+    /// Never seen by any sensor.
+    Unseen,
+}
+
 /// One run's world, sensors and tracks.
 pub struct Sim {
     /// The scenario, validated locally.
@@ -152,6 +167,27 @@ impl Sim {
                     t.pos,
                     fovs.iter().filter(|r| r.contains(t.pos)).count(),
                 )
+            })
+            .collect()
+    }
+
+    /// Every target in the zone now, with its position and what the sensors
+    /// know of it (see [`TargetStatus`]).
+    pub fn target_states(&self) -> Vec<(Point, TargetStatus)> {
+        let oldest = self.step.saturating_sub(self.history_len);
+        self.detections()
+            .into_iter()
+            .map(|(id, pos, n)| {
+                let status = if n > 0 {
+                    TargetStatus::Detected
+                } else {
+                    match self.last_seen.get(&id) {
+                        Some(&when) if when >= oldest => TargetStatus::Tracked,
+                        Some(_) => TargetStatus::Lost,
+                        None => TargetStatus::Unseen,
+                    }
+                };
+                (pos, status)
             })
             .collect()
     }

@@ -6,12 +6,14 @@
 //! - [`metrics`]: per-step counts, per-run averages, confidence intervals;
 //! - [`client`]: the HTTP client, and an in-process server for one-command runs;
 //! - [`experiment`]: runs over seeds and the paper's experiment grids;
+//! - [`live`]: the live view, one run watched in a browser;
 //! - [`report`]: the paper's table layout and JSON output;
 //! - [`svg`]: a picture of one run, like the paper's Figure 3.
 
 pub mod client;
 pub mod driver;
 pub mod experiment;
+pub mod live;
 pub mod metrics;
 pub mod policy;
 pub mod report;

@@ -6,6 +6,7 @@
 //! vigil-sim --experiment table2                     # every policy
 //! vigil-sim --experiment mixed                      # every policy on site-gates
 //! vigil-sim --policy exact --sensors 10 --svg run.svg
+//! vigil-sim --live --policy exact --sensors 10      # watch one run in a browser
 //! ```
 //! Without `--server` it starts a server in-process on a loopback port and
 //! still talks HTTP to it.
@@ -20,6 +21,7 @@ use vigil_sim::driver::{Start, default_warmup};
 use vigil_sim::experiment::{
     EXPERIMENTS, RunConfig, experiment_grid, experiment_policies, run_all, run_one,
 };
+use vigil_sim::live::{Live, LiveOptions};
 use vigil_sim::policy::Policy;
 use vigil_sim::{report, svg};
 
@@ -79,6 +81,18 @@ struct Args {
     /// Runs in flight at once.
     #[arg(long, default_value_t = 4)]
     jobs: usize,
+    /// Watch a single run (seed `--seed`) in a browser: serves a page on
+    /// `--live-bind` and steps at the rate the page sets. Closing the page
+    /// does not stop the run; after its last step the final state stays
+    /// served until Ctrl-C.
+    #[arg(long)]
+    live: bool,
+    /// Address of the live view's page.
+    #[arg(long, default_value = "127.0.0.1:8090")]
+    live_bind: String,
+    /// Steps per second of the live view at the start (the page changes it).
+    #[arg(long, default_value_t = 10.0)]
+    live_speed: f64,
 }
 
 #[tokio::main]
@@ -161,6 +175,17 @@ async fn run(args: Args) -> Result<(), String> {
     if configs.iter().any(|c| c.sensors == 0) {
         return Err("--sensors must be at least 1".into());
     }
+    if args.live {
+        if args.experiment.is_some() {
+            return Err("--live shows a single run; drop --experiment".into());
+        }
+        let opts = LiveOptions {
+            run: configs[0].clone(),
+            seed: args.seed,
+            speed: args.live_speed,
+        };
+        return live(client, opts, &args.live_bind).await;
+    }
     let rows = run_all(&client, &configs, args.seed, args.seeds.max(1), args.jobs)
         .await
         .map_err(|e| e.to_string())?;
@@ -180,5 +205,42 @@ async fn run(args: Args) -> Result<(), String> {
             svg::draw(&sim, path)?;
         }
     }
+    Ok(())
+}
+
+/// Serves the live view until Ctrl-C; a failed run ends it with the error.
+async fn live(client: Client, opts: LiveOptions, bind: &str) -> Result<(), String> {
+    let listener = tokio::net::TcpListener::bind(bind)
+        .await
+        .map_err(|e| format!("--live-bind {bind}: {e}"))?;
+    let steps = opts.run.steps;
+    let mut live = Live::start(listener, client, opts)
+        .await
+        .map_err(|e| e.to_string())?;
+    println!(
+        "live view: open {} (the run starts when the page opens; Ctrl-C stops)",
+        live.url()
+    );
+    let mut running = true;
+    loop {
+        tokio::select! {
+            signal = tokio::signal::ctrl_c() => {
+                signal.map_err(|e| format!("cannot wait for Ctrl-C: {e}"))?;
+                break;
+            }
+            done = live.finished(), if running => {
+                running = false;
+                match done {
+                    Ok(()) => println!("live view: all {steps} steps done; showing the final state until Ctrl-C"),
+                    Err(e) => {
+                        live.shutdown().await?;
+                        return Err(e.to_string());
+                    }
+                }
+            }
+        }
+    }
+    live.shutdown().await?;
+    println!("live view: stopped");
     Ok(())
 }

@@ -1,0 +1,280 @@
+//! The live view in a real browser: a headless Chromium driven through
+//! WebDriver (chromedriver, started here on a free port) opens the page of
+//! a live run served on a loopback port 0, and the DOM is checked: the step
+//! counter advances, every sensor is drawn, the metrics update, pause stops
+//! the counter, step advances it by one, and the `explain` switch draws.
+//! A screenshot goes to the target directory.
+//!
+//! Without a browser this test FAILS: `.ci/run` installs Debian's
+//! `chromium` and `chromium-driver`. `CHROMEDRIVER` and `CHROMIUM` override
+//! where they are looked for.
+
+use std::net::TcpListener as StdListener;
+use std::path::PathBuf;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use fantoccini::{ClientBuilder, Locator};
+use vigil::scenario::Scenario;
+use vigil_sim::client::{Client, spawn_local_server};
+use vigil_sim::driver::Start;
+use vigil_sim::experiment::RunConfig;
+use vigil_sim::live::{Live, LiveOptions};
+use vigil_sim::policy::Policy;
+
+const SENSORS: usize = 6;
+
+/// The first of `names` found on the PATH (or the override in `var`).
+fn find(var: &str, names: &[&str]) -> Option<PathBuf> {
+    if let Some(p) = std::env::var_os(var) {
+        return Some(PathBuf::from(p));
+    }
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path)
+        .flat_map(|dir| names.iter().map(move |n| dir.join(n)))
+        .find(|p| p.is_file())
+}
+
+/// Kills chromedriver when the test ends, however it ends.
+struct Driver(Child);
+
+impl Drop for Driver {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn free_port() -> u16 {
+    StdListener::bind("127.0.0.1:0")
+        .and_then(|l| l.local_addr())
+        .expect("a free loopback port")
+        .port()
+}
+
+async fn int_attr(el: &fantoccini::elements::Element, name: &str) -> i64 {
+    el.attr(name)
+        .await
+        .expect("attribute")
+        .unwrap_or_default()
+        .parse()
+        .unwrap_or(-1)
+}
+
+async fn step_now(c: &fantoccini::Client) -> i64 {
+    let el = c.find(Locator::Id("step")).await.expect("#step");
+    int_attr(&el, "data-step").await
+}
+
+/// Polls `f` every 50 ms until it holds, for at most `secs`.
+async fn until<F, Fut>(secs: u64, what: &str, mut f: F)
+where
+    F: FnMut() -> Fut,
+    Fut: std::future::Future<Output = bool>,
+{
+    let deadline = Instant::now() + Duration::from_secs(secs);
+    while !f().await {
+        assert!(Instant::now() < deadline, "timed out waiting for {what}");
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn live_view_in_headless_chromium() {
+    let started = Instant::now();
+    let Some(chromedriver) = find("CHROMEDRIVER", &["chromedriver"]) else {
+        panic!(
+            "\n\n*** NO BROWSER: chromedriver is not on the PATH. This test needs a real \
+             headless Chromium; install it with `apt-get install -y chromium chromium-driver` \
+             (as .ci/run does) or set CHROMEDRIVER and CHROMIUM. FAILING. ***\n"
+        );
+    };
+    let chromium = find(
+        "CHROMIUM",
+        &["chromium", "chromium-browser", "google-chrome", "chrome"],
+    );
+    let Some(chromium) = chromium else {
+        panic!(
+            "\n\n*** NO BROWSER: chromium is not on the PATH (chromedriver is at {}). \
+             Install `chromium` or set CHROMIUM. FAILING. ***\n",
+            chromedriver.display()
+        );
+    };
+
+    // The live view of a short run, on a loopback port 0.
+    let base = spawn_local_server().await.expect("in-process planner");
+    let client = Client::new(&base);
+    let info = client.scenario("paper-v10").await.expect("paper-v10");
+    let scenario = Scenario::new(info.spec).expect("valid scenario");
+    let run = RunConfig {
+        label: "live".into(),
+        policy: Policy::Exact,
+        scenario_id: info.id,
+        scenario,
+        sensors: SENSORS,
+        steps: 400,
+        warmup: 20,
+        horizon: None,
+        history: 16,
+        start: Start::Grid,
+    };
+    let listener = tokio::net::TcpListener::bind("127.0.0.1:0")
+        .await
+        .expect("loopback listener");
+    let live = Live::start(
+        listener,
+        client,
+        LiveOptions {
+            run,
+            seed: 3,
+            speed: 25.0,
+        },
+    )
+    .await
+    .expect("live view starts");
+    let url = live.url();
+
+    // chromedriver on a free port.
+    let port = free_port();
+    let _driver = Driver(
+        Command::new(&chromedriver)
+            .arg(format!("--port={port}"))
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap_or_else(|e| panic!("cannot start {}: {e}", chromedriver.display())),
+    );
+    let webdriver = format!("http://127.0.0.1:{port}");
+    let http = reqwest::Client::new();
+    until(20, "chromedriver to answer", || async {
+        http.get(format!("{webdriver}/status"))
+            .send()
+            .await
+            .is_ok_and(|r| r.status().is_success())
+    })
+    .await;
+
+    let mut caps = serde_json::Map::new();
+    caps.insert(
+        "goog:chromeOptions".into(),
+        serde_json::json!({
+            "binary": chromium,
+            "args": ["--headless=new", "--no-sandbox", "--disable-gpu",
+                     "--disable-dev-shm-usage", "--window-size=1240,900",
+                     "--hide-scrollbars"],
+        }),
+    );
+    let c = ClientBuilder::new(hyper_util::client::legacy::connect::HttpConnector::new())
+        .capabilities(caps)
+        .connect(&webdriver)
+        .await
+        .expect("a WebDriver session with headless Chromium");
+
+    c.goto(&url).await.expect("page opens");
+    // Frames arrive and the counter advances.
+    until(30, "the first frames", || async { step_now(&c).await >= 3 }).await;
+    let first = step_now(&c).await;
+    until(10, "the step counter to advance", || async {
+        step_now(&c).await >= first + 5
+    })
+    .await;
+
+    // Every sensor is drawn, and listed.
+    let zone = c.find(Locator::Id("zone")).await.expect("#zone");
+    assert_eq!(int_attr(&zone, "data-sensors-drawn").await, SENSORS as i64);
+    let rows = c
+        .find_all(Locator::Css("#sensor-table tbody tr.sensor"))
+        .await
+        .expect("sensor rows");
+    assert_eq!(rows.len(), SENSORS);
+
+    // The metrics update: their step follows the counter, the charts grow,
+    // and the numbers are numbers.
+    let metrics = c.find(Locator::Id("metrics")).await.expect("#metrics");
+    let chart = c.find(Locator::Id("c-ad")).await.expect("#c-ad");
+    let (m0, p0) = (
+        int_attr(&metrics, "data-step").await,
+        int_attr(&chart, "data-points").await,
+    );
+    until(10, "the metrics to update", || async {
+        int_attr(&metrics, "data-step").await > m0 && int_attr(&chart, "data-points").await > p0
+    })
+    .await;
+    for id in ["m-ad", "m-ad-mean", "m-af-mean", "m-once", "m-plan"] {
+        let text = c
+            .find(Locator::Id(id))
+            .await
+            .expect("metric")
+            .text()
+            .await
+            .expect("text");
+        let v: f64 = text
+            .parse()
+            .unwrap_or_else(|_| panic!("#{id} is not a number: {text:?}"));
+        assert!(v.is_finite() && v >= 0.0, "#{id} = {v}");
+    }
+
+    // Pause stops the counter.
+    c.find(Locator::Id("pause"))
+        .await
+        .expect("#pause")
+        .click()
+        .await
+        .expect("click pause");
+    until(5, "the page to show paused", || async {
+        c.find(Locator::Id("pause"))
+            .await
+            .expect("#pause")
+            .attr("data-paused")
+            .await
+            .ok()
+            .flatten()
+            .as_deref()
+            == Some("true")
+    })
+    .await;
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    let paused_at = step_now(&c).await;
+    tokio::time::sleep(Duration::from_millis(1200)).await;
+    assert_eq!(
+        step_now(&c).await,
+        paused_at,
+        "the counter moved while paused"
+    );
+
+    // Step advances it by exactly one.
+    c.find(Locator::Id("step-once"))
+        .await
+        .expect("#step-once")
+        .click()
+        .await
+        .expect("click step");
+    until(5, "one step", || async {
+        step_now(&c).await == paused_at + 1
+    })
+    .await;
+    tokio::time::sleep(Duration::from_millis(500)).await;
+    assert_eq!(step_now(&c).await, paused_at + 1, "step did more than one");
+
+    // The explain switch draws sensor 0's search values.
+    c.find(Locator::Id("explain"))
+        .await
+        .expect("#explain")
+        .click()
+        .await
+        .expect("click explain");
+    until(5, "the explain heat map", || async {
+        int_attr(&zone, "data-explain-drawn").await == 1
+    })
+    .await;
+
+    let png = c.screenshot().await.expect("screenshot");
+    assert!(png.starts_with(b"\x89PNG"), "not a PNG");
+    let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("live-view.png");
+    std::fs::write(&out, &png).expect("screenshot written");
+    eprintln!("live view screenshot: {}", out.display());
+
+    c.close().await.expect("session closes");
+    live.shutdown().await.expect("live view stops cleanly");
+    eprintln!("browser test took {:.1} s", started.elapsed().as_secs_f64());
+}
