@@ -39,6 +39,28 @@ pub struct RunConfig {
     pub start: Start,
 }
 
+impl RunConfig {
+    /// The run of `seed` after its warm-up: the zone has filled to its
+    /// stationary state while the sensors watched from their starting
+    /// cells, building tracks and history; the measured window starts now.
+    pub fn warmed_up(&self, seed: u64) -> Sim {
+        let mut sim = Sim::new(
+            self.scenario.clone(),
+            self.sensors,
+            self.start,
+            seed,
+            self.history,
+        );
+        for _ in 0..self.warmup {
+            sim.observe();
+            let stay = sim.sensors.clone();
+            sim.advance(stay);
+        }
+        sim.start_window();
+        sim
+    }
+}
+
 /// A failed run.
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
@@ -58,21 +80,7 @@ pub async fn run_one(
     seed: u64,
     keep: bool,
 ) -> Result<(Metrics, Option<Sim>), RunError> {
-    let mut sim = Sim::new(
-        cfg.scenario.clone(),
-        cfg.sensors,
-        cfg.start,
-        seed,
-        cfg.history,
-    );
-    // Warm-up: the zone fills to its stationary state while the sensors
-    // watch from their starting cells, building tracks and history.
-    for _ in 0..cfg.warmup {
-        sim.observe();
-        let stay = sim.sensors.clone();
-        sim.advance(stay);
-    }
-    sim.start_window();
+    let mut sim = cfg.warmed_up(seed);
     let mut acc = RunAccumulator::default();
     for _ in 0..cfg.steps {
         sim.observe();

@@ -580,19 +580,7 @@ async fn next_step_allowed(
 /// allow, publishing a frame after each.
 async fn drive(shared: Arc<Shared>, client: Client, opts: LiveOptions) -> Result<(), RunError> {
     let cfg = &opts.run;
-    let mut sim = Sim::new(
-        cfg.scenario.clone(),
-        cfg.sensors,
-        cfg.start,
-        opts.seed,
-        cfg.history,
-    );
-    for _ in 0..cfg.warmup {
-        sim.observe();
-        let stay = sim.sensors.clone();
-        sim.advance(stay);
-    }
-    sim.start_window();
+    let mut sim = cfg.warmed_up(opts.seed);
     let mut series = Series::default();
     let mut run = Running::default();
     let mut plan: Option<PlanResponse> = None;
