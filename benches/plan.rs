@@ -29,6 +29,7 @@ fn reference_request(planner: &Planner, horizon: usize) -> PlanRequest {
             id: Id::Number(i.into()),
             x: ((i % 4) as f64 + 0.5) * s.width / 4.0,
             y: ((i / 4) as f64 + 0.5) * s.height / 3.0,
+            sensor_type: None,
         })
         .collect();
     let fovs: Vec<Region> = sensors

@@ -10,9 +10,11 @@
 //!   paths, taking the new path only if it raises the total; it stops when a
 //!   round changes nothing, or after 10 rounds.
 //!
-//! The total is `Σ_t Σ_p value(p, cell_p(t), t, FOVs of the sensors ranked
-//! above p at t)`: for the exact estimator the expected number of distinct
-//! targets detected, whatever the order. In `Iterated` a sensor's value for a
+//! The total is `Σ_t Σ_p value(p, cell_p(t), t, looks of the sensors ranked
+//! above p at t)`: for the exact estimator the expected number of
+//! (target, step) pairs detected by at least one sensor, whatever the order
+//! (with detection probabilities, `Σ 1 − Π (1 − p)` over the sensors whose
+//! field of view holds the target). In `Iterated` a sensor's value for a
 //! cell is the change in that total when it stands there (its marginal
 //! against all the others for the exact estimator; for the paper estimator
 //! also the change in the lower-ranked sensors' overlap reductions), so each
@@ -22,9 +24,9 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use crate::estimator::{Estimator, for_reach};
+use crate::estimator::Estimator;
 use crate::geometry::Region;
-use crate::scenario::{Cell, Scenario};
+use crate::scenario::{Cell, FovSpec, Look, Scenario};
 use crate::search::{BestPath, ValueGrid, best_path};
 
 /// How sensors' searches are coordinated.
@@ -67,19 +69,24 @@ pub struct Coordinated {
     pub rounds: usize,
 }
 
-/// Plans `starts.len()` sensors over `horizon` steps.
+/// Plans `starts.len()` sensors of types `types` over `horizon` steps; each
+/// moves at its type's speed through the scenario's free cells.
 pub fn coordinate(
     s: &Scenario,
     est: &dyn Estimator,
     starts: &[Cell],
+    types: &[usize],
     horizon: usize,
     mode: Coordination,
 ) -> Coordinated {
     let n = starts.len();
+    let plan_one = |i: usize, fill: &mut dyn FnMut(usize, &mut ValueGrid)| {
+        search(s, starts[i], s.types[types[i]].speed, horizon, fill)
+    };
     // Every sensor alone.
     let mut plans: Vec<SensorPlan> = (0..n)
         .into_par_iter()
-        .map(|i| search(starts[i], horizon, |t, g| est.fill(i, starts[i], t, &[], g)))
+        .map(|i| plan_one(i, &mut |t, g| est.fill(i, starts[i], t, &[], g)))
         .collect();
     let mut order: Vec<usize> = (0..n).collect();
     // Stable sort: ties keep request order.
@@ -91,10 +98,8 @@ pub fn coordinate(
             let i = order[rank];
             let above = &order[..rank];
             let plan = {
-                let fovs = fovs_by_step(s, &plans, above, horizon, starts[i]);
-                search(starts[i], horizon, |t, g| {
-                    est.fill(i, starts[i], t, &fovs[t - 1], g)
-                })
+                let looks = looks_by_step(s, &plans, types, above, horizon, i, starts[i]);
+                plan_one(i, &mut |t, g| est.fill(i, starts[i], t, &looks[t - 1], g))
             };
             plans[i] = plan;
         }
@@ -108,14 +113,16 @@ pub fn coordinate(
                 let i = order[rank];
                 let grid_plan = if est.order_independent() {
                     let others: Vec<usize> = order.iter().copied().filter(|&j| j != i).collect();
-                    let fovs = fovs_by_step(s, &plans, &others, horizon, starts[i]);
-                    search(starts[i], horizon, |t, g| {
-                        est.fill(i, starts[i], t, &fovs[t - 1], g)
-                    })
+                    let looks = looks_by_step(s, &plans, types, &others, horizon, i, starts[i]);
+                    plan_one(i, &mut |t, g| est.fill(i, starts[i], t, &looks[t - 1], g))
                 } else {
-                    search(starts[i], horizon, |t, g| {
-                        for_reach(s, starts[i], t, |dc, dr, k| {
-                            g.set(t, dc, dr, total_change(s, est, &plans, &order, rank, k, t));
+                    plan_one(i, &mut |t, g| {
+                        g.fill_step(t, |dc, dr| {
+                            let k = Cell {
+                                col: starts[i].col + dc,
+                                row: starts[i].row + dr,
+                            };
+                            total_change(s, est, &plans, types, &order, rank, k, t)
                         });
                     })
                 };
@@ -144,9 +151,9 @@ pub fn coordinate(
                 .iter()
                 .enumerate()
                 .map(|(rank, &p)| {
-                    let above: Vec<Region> = order[..rank]
+                    let above: Vec<Look> = order[..rank]
                         .iter()
-                        .map(|&q| s.fov_region(plans[q].path[t - 1]))
+                        .map(|&q| s.look(types[q], plans[q].path[t - 1]))
                         .collect();
                     est.value(p, plans[p].path[t - 1], t, &above)
                 })
@@ -165,31 +172,33 @@ pub fn coordinate(
 /// in the total at step `t` when the sensor ranked `rank` stands at `k`
 /// instead of being absent. Its own value against the sensors above it,
 /// plus the change it causes in the reductions of the sensors below it.
+#[allow(clippy::too_many_arguments)]
 fn total_change(
     s: &Scenario,
     est: &dyn Estimator,
     plans: &[SensorPlan],
+    types: &[usize],
     order: &[usize],
     rank: usize,
     k: Cell,
     t: usize,
 ) -> f64 {
     let i = order[rank];
-    let fk = s.fov_region(k);
-    let above: Vec<Region> = order[..rank]
+    let fk = s.look(types[i], k);
+    let above: Vec<Look> = order[..rank]
         .iter()
-        .map(|&q| s.fov_region(plans[q].path[t - 1]))
+        .map(|&q| s.look(types[q], plans[q].path[t - 1]))
         .collect();
     let mut delta = est.value(i, k, t, &above);
     for (lower_rank, &q) in order.iter().enumerate().skip(rank + 1) {
-        let fq = s.fov_region(plans[q].path[t - 1]);
-        if !fq.may_overlap(&fk) {
+        let fq = s.fov_region_of(types[q], plans[q].path[t - 1]);
+        if !fq.may_overlap(&fk.region) {
             continue;
         }
-        let mut above_q: Vec<Region> = order[..lower_rank]
+        let mut above_q: Vec<Look> = order[..lower_rank]
             .iter()
             .filter(|&&p| p != i)
-            .map(|&p| s.fov_region(plans[p].path[t - 1]))
+            .map(|&p| s.look(types[p], plans[p].path[t - 1]))
             .collect();
         let without = est.value(q, plans[q].path[t - 1], t, &above_q);
         above_q.push(fk);
@@ -199,34 +208,39 @@ fn total_change(
     delta
 }
 
-/// The fields of view, at each step, of the `sensors` on their current
-/// paths, keeping those that can meet a cell reachable from `start`.
-fn fovs_by_step(
+/// The looks, at each step, of the `sensors` on their current paths,
+/// keeping those that can meet the field of view of a cell that sensor `i`
+/// can reach from `start`.
+fn looks_by_step(
     s: &Scenario,
     plans: &[SensorPlan],
+    types: &[usize],
     sensors: &[usize],
     horizon: usize,
+    i: usize,
     start: Cell,
-) -> Vec<Vec<Region>> {
+) -> Vec<Vec<Look>> {
     (1..=horizon)
         .map(|t| {
-            let reach = reach_box(s, start, t);
+            let reach = reach_box(s, types[i], start, t);
             sensors
                 .iter()
-                .map(|&q| s.fov_region(plans[q].path[t - 1]))
-                .filter(|r| r.may_overlap(&reach))
+                .map(|&q| s.look(types[q], plans[q].path[t - 1]))
+                .filter(|l| l.region.may_overlap(&reach))
                 .collect()
         })
         .collect()
 }
 
-/// A region bounding every field of view of a cell reachable in `t` steps.
-fn reach_box(s: &Scenario, start: Cell, t: usize) -> Region {
+/// A region bounding every field of view of a sensor of type `ty` at a
+/// cell it can reach in `t` steps.
+fn reach_box(s: &Scenario, ty: usize, start: Cell, t: usize) -> Region {
     let c = s.centre(start);
-    let half = match s.fov {
-        crate::scenario::FovSpec::Square { half_width } => half_width,
-        crate::scenario::FovSpec::Circle { radius } => radius,
-    } + t as f64 * s.cell_size;
+    let ty = &s.types[ty];
+    let half = match ty.fov {
+        FovSpec::Square { half_width } => half_width,
+        FovSpec::Circle { radius } => radius,
+    } + (ty.speed * t) as f64 * s.cell_size;
     Region {
         rect: crate::geometry::Rect {
             x0: c.x - half,
@@ -249,9 +263,21 @@ fn path_moves(start: Cell, path: &[Cell]) -> Vec<(i32, i32)> {
         .collect()
 }
 
-/// Fills a value grid step by step with `fill(t, grid)` and searches it.
-fn search(start: Cell, horizon: usize, mut fill: impl FnMut(usize, &mut ValueGrid)) -> SensorPlan {
-    let mut grid = ValueGrid::new(horizon);
+/// Fills a value grid step by step with `fill(t, grid)` and searches it,
+/// for a sensor of speed `speed` that may stand on the free cells only.
+fn search(
+    s: &Scenario,
+    start: Cell,
+    speed: usize,
+    horizon: usize,
+    fill: &mut dyn FnMut(usize, &mut ValueGrid),
+) -> SensorPlan {
+    let mut grid = ValueGrid::with_motion(horizon, speed, |dc, dr| {
+        s.is_free(Cell {
+            col: start.col + dc,
+            row: start.row + dr,
+        })
+    });
     for t in 1..=horizon {
         fill(t, &mut grid);
     }

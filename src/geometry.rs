@@ -241,13 +241,36 @@ impl Region {
     /// for rectangles (piecewise-constant chords), Gauss–Legendre between the
     /// breakpoints for disks.
     pub fn covered_area(&self, others: &[Region]) -> f64 {
-        let others: Vec<&Region> = others.iter().filter(|o| self.may_overlap(o)).collect();
+        let others: Vec<(&Region, f64)> = others
+            .iter()
+            .filter(|o| self.may_overlap(o))
+            .map(|o| (o, 1.0))
+            .collect();
+        self.cover(&others)
+    }
+
+    /// The expected area of this region in which a target is detected, when
+    /// each of `others` is a region `(r, p)` that detects a target inside it
+    /// with probability `p`, independently: `∫ 1 − Π_{r ∋ q} (1 − p) dq`.
+    /// With every `p = 1` it is [`Region::covered_area`], computed the same
+    /// way.
+    pub fn detected_area(&self, others: &[(Region, f64)]) -> f64 {
+        let others: Vec<(&Region, f64)> = others
+            .iter()
+            .filter(|(o, _)| self.may_overlap(o))
+            .map(|(o, p)| (o, *p))
+            .collect();
+        self.cover(&others)
+    }
+
+    fn cover(&self, others: &[(&Region, f64)]) -> f64 {
+        let certain = others.iter().all(|&(_, p)| p == 1.0);
         if others.is_empty() {
             return 0.0;
         }
         let (xa, xb) = (self.rect.x0, self.rect.x1);
         let mut xs = vec![xa, xb];
-        for reg in others.iter().copied().chain(std::iter::once(self)) {
+        for reg in others.iter().map(|o| o.0).chain(std::iter::once(self)) {
             xs.extend([reg.rect.x0, reg.rect.x1]);
             if let Some(d) = reg.disk {
                 xs.extend([d.c.x - d.r, d.c.x, d.c.x + d.r]);
@@ -262,13 +285,15 @@ impl Region {
         xs.retain(|&x| x >= xa && x <= xb);
         xs.sort_by(f64::total_cmp);
         xs.dedup();
-        let curved = self.disk.is_some() || others.iter().any(|o| o.disk.is_some());
+        let curved = self.disk.is_some() || others.iter().any(|o| o.0.disk.is_some());
         let (nodes, weights) = if curved {
             gauss_legendre(12)
         } else {
             gauss_legendre(1)
         };
         let mut chords: Vec<(f64, f64)> = Vec::with_capacity(others.len());
+        let mut weighted: Vec<(f64, f64, f64)> = Vec::new();
+        let mut events = Vec::new();
         let mut total = 0.0;
         for w in xs.windows(2) {
             let (a, b) = (w[0], w[1]);
@@ -292,9 +317,19 @@ impl Region {
                 let Some((ya, yb)) = self.vertical_chord(x) else {
                     continue;
                 };
-                chords.clear();
-                chords.extend(others.iter().filter_map(|o| o.vertical_chord(x)));
-                total += w * union_within(&mut chords, ya, yb);
+                if certain {
+                    chords.clear();
+                    chords.extend(others.iter().filter_map(|o| o.0.vertical_chord(x)));
+                    total += w * union_within(&mut chords, ya, yb);
+                } else {
+                    weighted.clear();
+                    weighted.extend(
+                        others
+                            .iter()
+                            .filter_map(|&(o, p)| o.vertical_chord(x).map(|(a, b)| (a, b, p))),
+                    );
+                    total += w * detection_within(&weighted, ya, yb, &mut events);
+                }
             }
         }
         total
@@ -335,6 +370,70 @@ pub fn union_within(intervals: &mut [(f64, f64)], lo: f64, hi: f64) -> f64 {
         }
     }
     covered
+}
+
+/// `∫_lo^hi 1 − Π (1 − p) dx` over the intervals `(a, b, p)` that hold `x`:
+/// the expected length of `[lo, hi]` in which a target is detected when
+/// each interval detects independently with probability `p ∈ (0, 1]`. With
+/// every `p = 1` it is the length of the union. `events` is scratch space.
+///
+/// ```
+/// use vigil::geometry::detection_within;
+/// let mut ev = Vec::new();
+/// // [0,2] at ½ and [1,3] at ½: 1·½ + 1·¾ + 1·½ over [0,3].
+/// let v = detection_within(&[(0.0, 2.0, 0.5), (1.0, 3.0, 0.5)], 0.0, 3.0, &mut ev);
+/// assert!((v - 1.75).abs() < 1e-12);
+/// // Certain intervals: the union's length, clipped to [lo, hi].
+/// let v = detection_within(&[(0.0, 2.0, 1.0), (1.0, 3.0, 1.0)], 0.5, 2.5, &mut ev);
+/// assert!((v - 2.0).abs() < 1e-12);
+/// ```
+pub fn detection_within(
+    intervals: &[(f64, f64, f64)],
+    lo: f64,
+    hi: f64,
+    events: &mut Vec<(f64, f64, bool)>,
+) -> f64 {
+    // Events (x, p, opens), swept in x order; the miss probability of the
+    // open intervals is kept as a count of certain ones and a sum of
+    // ln(1 − p) over the others.
+    events.clear();
+    for &(a, b, p) in intervals {
+        let (a, b) = (a.max(lo), b.min(hi));
+        if b > a {
+            events.push((a, p, true));
+            events.push((b, p, false));
+        }
+    }
+    events.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+    let (mut open, mut certain, mut log_miss) = (0usize, 0usize, 0.0f64);
+    let mut detected = 0.0;
+    let mut prev = lo;
+    for &(x, p, opens) in events.iter() {
+        if open > 0 && x > prev {
+            let miss = if certain > 0 { 0.0 } else { log_miss.exp() };
+            detected += (x - prev) * (1.0 - miss);
+        }
+        prev = x;
+        let sign = if opens { 1.0 } else { -1.0 };
+        if opens {
+            open += 1;
+        } else {
+            open -= 1;
+        }
+        if p >= 1.0 {
+            if opens {
+                certain += 1;
+            } else {
+                certain -= 1;
+            }
+        } else {
+            log_miss += sign * (-p).ln_1p();
+        }
+        if open == 0 {
+            log_miss = 0.0;
+        }
+    }
+    detected
 }
 
 /// ∫∫ over the rectangle `[x0,x1]×[y0,y1]` (coordinates relative to the

@@ -13,8 +13,10 @@ use crate::coordination::{Coordination, coordinate};
 use crate::estimator::{
     ElementaryGrid, Estimator, ExactEstimator, PaperEstimator, SourceRays, Target,
 };
-use crate::geometry::{Point, Region};
-use crate::scenario::{Cell, Integer, Scenario, ValidationError, check_horizon};
+use crate::geometry::Point;
+use crate::scenario::{
+    Cell, DEFAULT_TYPE, Integer, Look, Scenario, ValidationError, check_horizon,
+};
 use crate::stats::Stats;
 
 /// Most sensors in one request.
@@ -72,6 +74,7 @@ impl Id {
 /// A sensor's current position.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(examples(json!({"id": "d1", "x": 155.0, "y": 145.0, "type": "drone"})))]
 pub struct SensorIn {
     /// Unique id.
     pub id: Id,
@@ -79,6 +82,11 @@ pub struct SensorIn {
     pub x: f64,
     /// North coordinate.
     pub y: f64,
+    /// Its sensor type (a name of the scenario's `sensor_types`);
+    /// `default` by default.
+    #[serde(rename = "type", default, skip_serializing_if = "Option::is_none")]
+    #[schema(max_length = 32)]
+    pub sensor_type: Option<String>,
 }
 
 /// A reported target.
@@ -98,14 +106,30 @@ pub struct TargetIn {
     pub vy: f64,
 }
 
-/// A past sensor position.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, ToSchema)]
+/// A past sensor position: a look taken then.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PositionIn {
     /// East coordinate.
     pub x: f64,
     /// North coordinate.
     pub y: f64,
+    /// The type of the sensor that stood there (its field of view and
+    /// `p_detect`); `default` by default.
+    #[serde(rename = "type", default, skip_serializing_if = "Option::is_none")]
+    #[schema(max_length = 32)]
+    pub sensor_type: Option<String>,
+}
+
+impl PositionIn {
+    /// A position of a `default` sensor.
+    pub fn at(x: f64, y: f64) -> Self {
+        PositionIn {
+            x,
+            y,
+            sensor_type: None,
+        }
+    }
 }
 
 /// Body of `POST /v1/scenarios/{id}/plan`.
@@ -157,7 +181,8 @@ pub struct CellOut {
 /// The search values of one sensor.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
 pub struct Explain {
-    /// `values[t−1][dr+T][dc+T]`; null where unreachable or off the lattice.
+    /// `values[t−1][dr+m·T][dc+m·T]` (m the sensor's speed); null where
+    /// unreachable by step t, blocked or off the lattice.
     pub values: Vec<Vec<Vec<Option<f64>>>>,
 }
 
@@ -205,8 +230,10 @@ pub struct PlanResponse {
 pub struct PlanInput {
     ids: Vec<Id>,
     starts: Vec<Cell>,
+    types: Vec<usize>,
     targets: Vec<Target>,
-    history: Vec<Vec<Cell>>,
+    /// Past looks: cells and sensor types, newest first.
+    history: Vec<Vec<(Cell, usize)>>,
     horizon: usize,
     estimator: EstimatorKind,
     coordination: Coordination,
@@ -268,9 +295,36 @@ impl PlanInput {
                 }
                 Ok(s.snap(p))
             };
+        let type_of = |field: &dyn Fn() -> String, name: Option<&str>| {
+            let name = name.unwrap_or(DEFAULT_TYPE);
+            s.type_index(name).ok_or_else(|| {
+                let known: Vec<&str> = s.types.iter().map(|t| t.name.as_str()).collect();
+                ValidationError::new(
+                    format!("{}.type", field()),
+                    format!(
+                        "unknown sensor type {name:?}; the scenario has {}",
+                        known.join(", ")
+                    ),
+                )
+            })
+        };
+        let free = |field: &dyn Fn() -> String, c: Cell| {
+            if s.is_blocked(c) {
+                Err(ValidationError::new(
+                    field(),
+                    format!(
+                        "cell (col {}, row {}) is in a no-go zone: no sensor may stand on it",
+                        c.col, c.row
+                    ),
+                ))
+            } else {
+                Ok(c)
+            }
+        };
         let mut seen = HashSet::new();
         let mut ids = Vec::with_capacity(req.sensors.len());
         let mut starts = Vec::with_capacity(req.sensors.len());
+        let mut types = Vec::with_capacity(req.sensors.len());
         for (i, sensor) in req.sensors.iter().enumerate() {
             if !seen.insert(sensor.id.key()) {
                 return Err(ValidationError::new(
@@ -278,7 +332,9 @@ impl PlanInput {
                     "duplicate sensor id",
                 ));
             }
-            starts.push(in_zone(&|| format!("sensors[{i}]"), sensor.x, sensor.y)?);
+            let field = || format!("sensors[{i}]");
+            types.push(type_of(&field, sensor.sensor_type.as_deref())?);
+            starts.push(free(&field, in_zone(&field, sensor.x, sensor.y)?)?);
             ids.push(sensor.id.clone());
         }
         let mut targets = Vec::with_capacity(req.targets.len());
@@ -305,14 +361,19 @@ impl PlanInput {
             past.push(
                 step.iter()
                     .enumerate()
-                    .map(|(pi, p)| in_zone(&|| format!("history[{si}][{pi}]"), p.x, p.y))
-                    .collect::<Result<Vec<_>, _>>()?,
+                    .map(|(pi, p)| {
+                        let field = || format!("history[{si}][{pi}]");
+                        let ty = type_of(&field, p.sensor_type.as_deref())?;
+                        Ok((free(&field, in_zone(&field, p.x, p.y)?)?, ty))
+                    })
+                    .collect::<Result<Vec<_>, ValidationError>>()?,
             );
         }
         let horizon = check_horizon("horizon", req.horizon.as_ref(), s.horizon)?;
         Ok(PlanInput {
             ids,
             starts,
+            types,
             targets,
             history: past,
             horizon,
@@ -329,8 +390,9 @@ impl PlanInput {
 pub struct Planner {
     /// The scenario.
     pub scenario: Scenario,
-    /// Its per-cell statistics.
-    pub stats: Stats,
+    /// Its per-cell statistics, per field of view (the scenario's `fovs`;
+    /// `stats[0]` is the type `default`'s).
+    pub stats: Vec<Stats>,
     rays: Vec<SourceRays>,
     grid: Option<ElementaryGrid>,
     /// Time the precomputation took, milliseconds.
@@ -341,7 +403,11 @@ impl Planner {
     /// Precomputes the statistics of a scenario.
     pub fn new(scenario: Scenario) -> Self {
         let started = Instant::now();
-        let stats = Stats::compute(&scenario);
+        let stats = scenario
+            .fovs
+            .iter()
+            .map(|&fov| Stats::for_fov(&scenario, fov))
+            .collect();
         let mut rays = SourceRays::for_scenario(&scenario);
         let grid = ElementaryGrid::new(&scenario);
         if let Some(grid) = &grid {
@@ -356,9 +422,15 @@ impl Planner {
         }
     }
 
+    /// The statistics of the sensor type `ty`'s field of view.
+    pub fn stats_of(&self, ty: usize) -> &Stats {
+        &self.stats[self.scenario.types[ty].fov_slot]
+    }
+
     /// Approximate heap memory held, bytes (for cache bounds).
     pub fn memory_bytes(&self) -> usize {
-        let stats = 3 * self.scenario.cell_count() * std::mem::size_of::<f64>();
+        let stats = 3 * self.stats.len() * self.scenario.cell_count() * std::mem::size_of::<f64>()
+            + self.scenario.cell_count();
         let grid = self.grid.as_ref().map_or(0, ElementaryGrid::memory_bytes);
         let rays: usize = self.rays.iter().map(SourceRays::memory_bytes).sum();
         std::mem::size_of::<Self>() + stats + grid + rays
@@ -385,11 +457,12 @@ impl Planner {
                 s,
                 &self.stats,
                 &input.starts,
+                &input.types,
                 &input.targets,
                 input.horizon,
             )),
             EstimatorKind::Exact => {
-                let observed = self.observed_regions(input);
+                let observed = self.observed_looks(input);
                 let est = ExactEstimator::new(
                     s,
                     &self.stats,
@@ -398,6 +471,7 @@ impl Planner {
                     &observed,
                     &input.targets,
                     &input.starts,
+                    &input.types,
                     input.horizon,
                 );
                 est.prepare();
@@ -408,6 +482,7 @@ impl Planner {
             s,
             est.as_ref(),
             &input.starts,
+            &input.types,
             input.horizon,
             input.coordination,
         );
@@ -451,31 +526,39 @@ impl Planner {
         }
     }
 
-    /// `O_s` for s = 0, 1, …: the fields of view now and in the history
-    /// (the whole zone now, when the caller reports every target in it).
-    fn observed_regions(&self, input: &PlanInput) -> Vec<Vec<Region>> {
+    /// `O_s` for s = 0, 1, …: the looks taken now and in the history (the
+    /// whole zone, certain, now when the caller reports every target in it).
+    fn observed_looks(&self, input: &PlanInput) -> Vec<Vec<Look>> {
         let s = &self.scenario;
         let now = match input.observed {
-            Observed::Zone => vec![s.zone_region()],
-            Observed::Sensors => dedup(&input.starts)
-                .into_iter()
-                .map(|c| s.fov_region(c))
-                .collect(),
+            Observed::Zone => vec![Look::certain(s.zone_region())],
+            Observed::Sensors => dedup(
+                input
+                    .starts
+                    .iter()
+                    .copied()
+                    .zip(input.types.iter().copied()),
+            )
+            .into_iter()
+            .map(|(c, ty)| s.look(ty, c))
+            .collect(),
         };
         std::iter::once(now)
-            .chain(
-                input
-                    .history
-                    .iter()
-                    .map(|step| dedup(step).into_iter().map(|c| s.fov_region(c)).collect()),
-            )
+            .chain(input.history.iter().map(|step| {
+                dedup(step.iter().copied())
+                    .into_iter()
+                    .map(|(c, ty)| s.look(ty, c))
+                    .collect()
+            }))
             .collect()
     }
 }
 
-/// The cells without repeats, in their order (the estimator reads the
-/// i-th position of each step as one sensor's track).
-fn dedup(cells: &[Cell]) -> Vec<Cell> {
-    let mut seen = HashSet::with_capacity(cells.len());
-    cells.iter().copied().filter(|c| seen.insert(*c)).collect()
+/// The looks (cell and type) without repeats, in their order (the
+/// estimator reads the i-th position of each step as one sensor's track).
+/// Two sensors of the same type on one cell take one look: they see the
+/// same targets at once.
+fn dedup(looks: impl Iterator<Item = (Cell, usize)>) -> Vec<(Cell, usize)> {
+    let mut seen = HashSet::new();
+    looks.filter(|l| seen.insert(*l)).collect()
 }

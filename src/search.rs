@@ -42,6 +42,7 @@ pub struct ValueGrid {
     horizon: usize,
     side: usize,
     values: Vec<Option<f64>>,
+    free: Option<Vec<bool>>,
 }
 
 impl ValueGrid {
@@ -52,6 +53,38 @@ impl ValueGrid {
             horizon,
             side,
             values: vec![None; horizon * side * side],
+            free: None,
+        }
+    }
+
+    /// TEMPORARY (speed 1).
+    pub fn with_motion(horizon: usize, _speed: usize, free: impl Fn(i32, i32) -> bool) -> Self {
+        let mut g = Self::new(horizon);
+        g.free = Some(
+            (0..g.side * g.side)
+                .map(|i| {
+                    let h = horizon as i32;
+                    free((i % g.side) as i32 - h, (i / g.side) as i32 - h)
+                })
+                .collect(),
+        );
+        g
+    }
+
+    /// TEMPORARY.
+    pub fn fill_step(&mut self, t: usize, mut f: impl FnMut(i32, i32) -> f64) {
+        let ti = t as i32;
+        for dr in -ti..=ti {
+            for dc in -ti..=ti {
+                let ok = self.free.as_ref().is_none_or(|fr| {
+                    fr[((dr + self.horizon as i32) as usize) * self.side
+                        + (dc + self.horizon as i32) as usize]
+                });
+                if ok {
+                    let v = f(dc, dr);
+                    self.set(t, dc, dr, v);
+                }
+            }
         }
     }
 

@@ -27,7 +27,7 @@
 use rayon::prelude::*;
 
 use crate::geometry::{Point, Region, gauss_legendre, inv_r_integral, wedge_inv_r_integral};
-use crate::scenario::{MAX_HORIZON, Scenario, Source};
+use crate::scenario::{FovSpec, MAX_HORIZON, Scenario, Source};
 
 /// The statistics of every cell, row-major (`row·cols + col`).
 #[derive(Debug, Clone)]
@@ -114,12 +114,19 @@ pub fn chord_integral(source: &Source, region: &Region, buf: &mut Vec<Point>) ->
 }
 
 impl Stats {
-    /// Computes the statistics of every cell (in parallel).
+    /// Computes the statistics of every cell for the type `default`'s field
+    /// of view (in parallel).
     pub fn compute(s: &Scenario) -> Stats {
+        Self::for_fov(s, s.fov)
+    }
+
+    /// The statistics of every cell for a sensor with field of view `fov`
+    /// (in parallel).
+    pub fn for_fov(s: &Scenario, fov: FovSpec) -> Stats {
         let per_cell: Vec<(f64, f64)> = (0..s.cell_count())
             .into_par_iter()
             .map_init(Vec::new, |buf, i| {
-                let region = s.fov_region(s.cell_at(i));
+                let region = s.fov_with(fov, s.centre(s.cell_at(i)));
                 let mut lambda_hat = 0.0;
                 let mut d_hat = 0.0;
                 for (j, src) in s.sources.iter().enumerate() {

@@ -38,7 +38,7 @@ fn paper_builtins_answer_exactly_as_before() {
             "{id}: spec"
         );
         let planner = Planner::new(scenario);
-        let st = &planner.stats;
+        let st = &planner.stats[0];
         let stats = json!({
             "lambda_hat": st.lambda_hat, "escape_time": st.escape_time, "d_hat": st.d_hat,
             "expected_targets_in_zone": st.expected_targets_in_zone,

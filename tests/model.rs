@@ -15,8 +15,8 @@ use vigil::estimator::{
 use vigil::geometry::{Point, Region};
 use vigil::planner::{EstimatorKind, Id, PlanRequest, Planner, SensorIn, TargetIn};
 use vigil::scenario::{
-    Cell, FovSpec, Heading, Scenario, ScenarioSpec, SourceSpec, SpeedSpec, ZoneSpec, builtins,
-    paper_spec,
+    Cell, FovSpec, Heading, Look, Scenario, ScenarioSpec, SourceSpec, SpeedSpec, ZoneSpec,
+    builtins, paper_spec,
 };
 use vigil::stats::Stats;
 use vigil::world::World;
@@ -224,17 +224,23 @@ fn run_unbiasedness_with(
                 })
                 .collect();
             let history_len = if pass_history { steps } else { 0 };
-            let observed: Vec<Vec<Region>> = (0..=history_len)
-                .map(|s_ago| at(s_ago).iter().map(|&c| s.fov_region(c)).collect())
+            let observed: Vec<Vec<Look>> = (0..=history_len)
+                .map(|s_ago| {
+                    at(s_ago)
+                        .iter()
+                        .map(|&c| Look::certain(s.fov_region(c)))
+                        .collect()
+                })
                 .collect();
             let est = ExactEstimator::new(
                 model,
-                &stats,
+                std::slice::from_ref(&stats),
                 &rays,
                 grid.as_ref(),
                 &observed,
                 &reported,
                 &sensors,
+                &vec![0; sensors.len()],
                 tmax,
             );
             let predicted: Vec<f64> = probes
@@ -377,6 +383,7 @@ fn snapshot_request(s: &Scenario, sensors: usize, seed: u64) -> PlanRequest {
             id: Id::Number(i.into()),
             x: rng.random::<f64>() * s.width,
             y: rng.random::<f64>() * s.height,
+            sensor_type: None,
         })
         .collect();
     let fovs: Vec<Region> = sensors
@@ -460,11 +467,13 @@ fn exact_total_counts_distinct_known_targets() {
                 id: Id::Text("a".into()),
                 x: 155.0,
                 y: 155.0,
+                sensor_type: None,
             },
             SensorIn {
                 id: Id::Text("b".into()),
                 x: 165.0,
                 y: 155.0,
+                sensor_type: None,
             },
         ],
         targets: [(150.0, 150.0), (160.0, 160.0), (140.0, 170.0)]
@@ -536,15 +545,15 @@ fn fast_and_general_exact_paths_agree() {
                     row: rng.random_range(0..s.rows),
                 })
                 .collect();
-            let history: Vec<Vec<Region>> = (0..4)
+            let history: Vec<Vec<Look>> = (0..4)
                 .map(|h| {
                     starts
                         .iter()
                         .map(|c| {
-                            s.fov_region(Cell {
+                            Look::certain(s.fov_region(Cell {
                                 col: (c.col + h).min(s.cols - 1),
                                 row: c.row,
-                            })
+                            }))
                         })
                         .collect()
                 })
@@ -560,22 +569,23 @@ fn fast_and_general_exact_paths_agree() {
             let horizon = 3;
             let est = ExactEstimator::new(
                 s,
-                &stats,
+                std::slice::from_ref(&stats),
                 rays,
                 grid.as_ref(),
                 &history,
                 &targets,
                 &starts,
+                &[0; 4],
                 horizon,
             );
             for (i, &start) in starts.iter().enumerate() {
                 let other = starts[(i + 1) % starts.len()];
                 let excluded = [
-                    s.fov_region(Cell {
+                    Look::certain(s.fov_region(Cell {
                         col: start.col + 1,
                         row: start.row,
-                    }),
-                    s.fov_region(other),
+                    })),
+                    Look::certain(s.fov_region(other)),
                 ];
                 for t in 1..=horizon {
                     let mut g = vigil::search::ValueGrid::new(horizon);
@@ -591,7 +601,7 @@ fn fast_and_general_exact_paths_agree() {
                                 continue;
                             }
                             let fast = est.value(i, k, t, &[]);
-                            let general = est.value_by_rays(k, t, &[]);
+                            let general = est.value_by_rays(i, k, t, &[]);
                             assert!(
                                 (fast - general).abs() < 1e-9,
                                 "{k:?} t={t}: {fast} vs {general}"
@@ -602,7 +612,7 @@ fn fast_and_general_exact_paths_agree() {
                             // midpoint rule on the square scenarios' grid of
                             // δ = π/128 (measured worst 4.1e-2 of a target, next to
                             // a source); the fast path subtracts it exactly.
-                            let general_x = est.value_by_rays(k, t, &excluded);
+                            let general_x = est.value_by_rays(i, k, t, &excluded);
                             worst =
                                 worst.max((fast_x - general_x).abs() / general_x.abs().max(1.0));
                             assert!(
@@ -633,6 +643,10 @@ fn mixture_spec(fov: FovSpec) -> ScenarioSpec {
         },
         cell_size: 10.0,
         fov,
+        sensor_speed: None,
+        p_detect: None,
+        sensor_types: None,
+        no_go: None,
         target_speed: Some(8.0),
         sources: vec![
             SourceSpec {

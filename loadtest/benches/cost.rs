@@ -167,6 +167,10 @@ pub fn lattice(side: usize) -> Scenario {
         },
         cell_size: 10.0,
         fov: FovSpec::Square { half_width: 30.0 },
+        sensor_speed: None,
+        p_detect: None,
+        sensor_types: None,
+        no_go: None,
         target_speed: Some(10.0),
         sources: vec![
             src(-1.0, w / 3.0),
@@ -192,7 +196,7 @@ fn precompute(c: &mut Criterion) {
         let planner = Planner::new(s.clone());
         // The zone's expected population, from the statistics, against the
         // closed form over the zone (an independent computation).
-        let total: f64 = planner.stats.expected_targets_in_zone;
+        let total: f64 = planner.stats[0].expected_targets_in_zone;
         assert!(total.is_finite() && total > 0.0);
         // Small lattices carry fixed costs (the rays' index); the bound is
         // for large ones.

@@ -3,7 +3,7 @@
 use vigil::estimator::{ElementaryGrid, Estimator, ExactEstimator, SourceRays, Target};
 use vigil::geometry::Point;
 use vigil::planner::Planner;
-use vigil::scenario::{Cell, builtins};
+use vigil::scenario::{Cell, Look, builtins};
 use vigil::stats::Stats;
 use vigil_loadtest::workload::Workload;
 
@@ -20,9 +20,18 @@ fn main() {
         for req in &reqs {
             let snap = |x: f64, y: f64| s.snap(Point::new(x, y));
             let starts: Vec<Cell> = req.sensors.iter().map(|p| snap(p.x, p.y)).collect();
-            let mut observed = vec![starts.iter().map(|&c| s.fov_region(c)).collect::<Vec<_>>()];
+            let mut observed = vec![
+                starts
+                    .iter()
+                    .map(|&c| Look::certain(s.fov_region(c)))
+                    .collect::<Vec<_>>(),
+            ];
             for step in req.history.as_deref().unwrap_or(&[]) {
-                observed.push(step.iter().map(|p| s.fov_region(snap(p.x, p.y))).collect());
+                observed.push(
+                    step.iter()
+                        .map(|p| Look::certain(s.fov_region(snap(p.x, p.y))))
+                        .collect(),
+                );
             }
             let targets: Vec<Target> = req
                 .targets
@@ -34,22 +43,24 @@ fn main() {
                 .collect();
             let a = ExactEstimator::new(
                 &s,
-                &stats,
+                std::slice::from_ref(&stats),
                 &rays,
                 grid.as_ref(),
                 &observed,
                 &targets,
                 &starts,
+                &vec![0; starts.len()],
                 3,
             );
             let b = ExactEstimator::new(
                 &s,
-                &stats,
+                std::slice::from_ref(&stats),
                 &fine,
                 grid.as_ref(),
                 &observed,
                 &targets,
                 &starts,
+                &vec![0; starts.len()],
                 3,
             );
             for (i, &c) in starts.iter().enumerate() {

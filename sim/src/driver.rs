@@ -219,6 +219,7 @@ impl Sim {
                 id: Id::Number(i.into()),
                 x: centre(c).x,
                 y: centre(c).y,
+                sensor_type: None,
             })
             .collect();
         let clairvoyant = policy == Policy::Clairvoyant;
@@ -246,10 +247,7 @@ impl Sim {
             .iter()
             .map(|step| {
                 step.iter()
-                    .map(|&c| PositionIn {
-                        x: centre(c).x,
-                        y: centre(c).y,
-                    })
+                    .map(|&c| PositionIn::at(centre(c).x, centre(c).y))
                     .collect()
             })
             .collect::<Vec<_>>();

@@ -23,10 +23,11 @@ pub struct ElementaryGrid {
     pub xs: Vec<f64>,
     /// Breakpoints in y, ascending, from 0 to H.
     pub ys: Vec<f64>,
-    /// Per column, the half-open range of x-intervals `F_k` covers.
-    col_span: Vec<(usize, usize)>,
-    /// Per row, the half-open range of y-intervals `F_k` covers.
-    row_span: Vec<(usize, usize)>,
+    /// Per field of view (the scenario's `fovs`) and column, the half-open
+    /// range of x-intervals `F_k` covers.
+    col_span: Vec<Vec<(usize, usize)>>,
+    /// The same per row, in y.
+    row_span: Vec<Vec<(usize, usize)>>,
     /// `prefix[b·nx + a]`: stationary targets in `[0, xs[a]] × [0, ys[b]]`.
     prefix: Vec<f64>,
     /// Lookup tables that find a coordinate's interval in O(1) on average:
@@ -86,9 +87,13 @@ fn g_half_plane(x: f64, y: f64) -> f64 {
     a + b
 }
 
-fn breakpoints(centres: impl Iterator<Item = f64>, half: f64, extent: f64) -> Vec<f64> {
+fn breakpoints(centres: impl Iterator<Item = f64>, halves: &[f64], extent: f64) -> Vec<f64> {
     let mut v: Vec<f64> = centres
-        .flat_map(|c| [(c - half).max(0.0), (c + half).min(extent)])
+        .flat_map(|c| {
+            halves
+                .iter()
+                .flat_map(move |&h| [(c - h).max(0.0), (c + h).min(extent)])
+        })
         .chain([0.0, extent])
         .collect();
     v.sort_by(f64::total_cmp);
@@ -193,15 +198,21 @@ fn stationary_prefix(s: &Scenario, xs: &[f64], ys: &[f64]) -> Vec<f64> {
 }
 
 impl ElementaryGrid {
-    /// The grid of a scenario with square fields of view; `None` for circles.
+    /// The grid of a scenario whose sensor types all have square fields of
+    /// view (the breakpoints of every size); `None` when one is a circle.
     pub fn new(s: &Scenario) -> Option<Self> {
-        let FovSpec::Square { half_width: h } = s.fov else {
-            return None;
-        };
+        let halves = s
+            .fovs
+            .iter()
+            .map(|f| match *f {
+                FovSpec::Square { half_width } => Some(half_width),
+                FovSpec::Circle { .. } => None,
+            })
+            .collect::<Option<Vec<f64>>>()?;
         let xc = |c: i32| (c as f64 + 0.5) * s.cell_size;
-        let xs = breakpoints((0..s.cols).map(xc), h, s.width);
-        let ys = breakpoints((0..s.rows).map(xc), h, s.height);
-        let span = |bp: &[f64], n: i32, extent: f64| -> Vec<(usize, usize)> {
+        let xs = breakpoints((0..s.cols).map(xc), &halves, s.width);
+        let ys = breakpoints((0..s.rows).map(xc), &halves, s.height);
+        let span = |bp: &[f64], n: i32, extent: f64, h: f64| -> Vec<(usize, usize)> {
             (0..n)
                 .map(|c| {
                     (
@@ -211,8 +222,14 @@ impl ElementaryGrid {
                 })
                 .collect()
         };
-        let col_span = span(&xs, s.cols, s.width);
-        let row_span = span(&ys, s.rows, s.height);
+        let col_span = halves
+            .iter()
+            .map(|&h| span(&xs, s.cols, s.width, h))
+            .collect();
+        let row_span = halves
+            .iter()
+            .map(|&h| span(&ys, s.rows, s.height, h))
+            .collect();
         let prefix = stationary_prefix(s, &xs, &ys);
         let (x_buckets, x_scale) = buckets(&xs);
         let (y_buckets, y_scale) = buckets(&ys);
@@ -232,7 +249,12 @@ impl ElementaryGrid {
     /// Approximate heap memory held, bytes.
     pub fn memory_bytes(&self) -> usize {
         8 * (self.xs.len() + self.ys.len() + self.prefix.len())
-            + 16 * (self.col_span.len() + self.row_span.len())
+            + 16 * self
+                .col_span
+                .iter()
+                .chain(&self.row_span)
+                .map(Vec::len)
+                .sum::<usize>()
             + 4 * (self.x_buckets.len() + self.y_buckets.len())
     }
 
@@ -241,11 +263,13 @@ impl ElementaryGrid {
         (self.xs.len() - 1, self.ys.len() - 1)
     }
 
-    /// The block `[a0, a1) × [b0, b1)` of rectangles that makes up `F_k`.
+    /// The block `[a0, a1) × [b0, b1)` of rectangles that makes up `F_k`
+    /// for the field of view `fov_slot` (an index into the scenario's
+    /// `fovs`; 0 is the type `default`'s).
     #[inline]
-    pub fn span(&self, k: Cell) -> (usize, usize, usize, usize) {
-        let (a0, a1) = self.col_span[k.col as usize];
-        let (b0, b1) = self.row_span[k.row as usize];
+    pub fn span(&self, fov_slot: usize, k: Cell) -> (usize, usize, usize, usize) {
+        let (a0, a1) = self.col_span[fov_slot][k.col as usize];
+        let (b0, b1) = self.row_span[fov_slot][k.row as usize];
         (a0, a1, b0, b1)
     }
 
@@ -383,7 +407,7 @@ mod tests {
             let grid = ElementaryGrid::new(&s).expect("square");
             let stats = Stats::compute(&s);
             for i in 0..s.cell_count() {
-                let (a0, a1, b0, b1) = grid.span(s.cell_at(i));
+                let (a0, a1, b0, b1) = grid.span(0, s.cell_at(i));
                 let m = grid.mass(a0, a1, b0, b1);
                 assert!(
                     (m - stats.d_hat[i]).abs() < 1e-9 * stats.d_hat[i].max(1.0),

@@ -3,8 +3,8 @@
 //!
 //! Both answer the same question through [`Estimator::value`] (one cell) and
 //! [`Estimator::fill`] (every cell a sensor can reach at a step), optionally
-//! leaving out what lies inside `excluded` regions (the fields of view of
-//! other sensors at the same step), which is what coordination needs.
+//! leaving out what `excluded` looks detect (the other sensors' at the same
+//! step), which is what coordination needs.
 //!
 //! - [`PaperEstimator`]: equations (1) and (2) of Krishna, Hexmoor and Sogani.
 //! - [`ExactEstimator`]: the conditional expectation under the model, by
@@ -18,8 +18,8 @@ pub use elementary::ElementaryGrid;
 pub use exact::{ExactEstimator, RAYS_PER_PI, RAYS_PER_PI_SQUARE, SourceRays};
 pub use paper::PaperEstimator;
 
-use crate::geometry::{Point, Region};
-use crate::scenario::{Cell, Scenario};
+use crate::geometry::Point;
+use crate::scenario::{Cell, Look, Scenario};
 use crate::search::ValueGrid;
 
 /// A target as reported: position now (step 0) and velocity per step.
@@ -47,22 +47,22 @@ pub trait Estimator: Sync {
     /// The scenario estimated.
     fn scenario(&self) -> &Scenario;
 
-    /// `n̂` for `sensor` (its index in the request) at cell `k` and step `t`,
-    /// counting only targets outside every region of `excluded`.
-    fn value(&self, sensor: usize, k: Cell, t: usize, excluded: &[Region]) -> f64;
+    /// `n̂` for `sensor` (its index in the request) at cell `k` and step `t`:
+    /// the expected targets it detects there (its `p_detect` times those in
+    /// its field of view), counting each target only with the probability
+    /// that every look of `excluded` misses it.
+    fn value(&self, sensor: usize, k: Cell, t: usize, excluded: &[Look]) -> f64;
 
-    /// Sets `grid`'s values at step `t` for every on-lattice cell within `t`
-    /// moves of `start` (the sensor's start), as [`Estimator::value`] would.
-    fn fill(
-        &self,
-        sensor: usize,
-        start: Cell,
-        t: usize,
-        excluded: &[Region],
-        grid: &mut ValueGrid,
-    ) {
-        for_reach(self.scenario(), start, t, |dc, dr, k| {
-            grid.set(t, dc, dr, self.value(sensor, k, t, excluded));
+    /// Sets `grid`'s values at step `t` for every cell the sensor can reach
+    /// by then from `start` (the sensor's start), as [`Estimator::value`]
+    /// would.
+    fn fill(&self, sensor: usize, start: Cell, t: usize, excluded: &[Look], grid: &mut ValueGrid) {
+        grid.fill_step(t, |dc, dr| {
+            let k = Cell {
+                col: start.col + dc,
+                row: start.row + dr,
+            };
+            self.value(sensor, k, t, excluded)
         });
     }
 
@@ -70,20 +70,4 @@ pub trait Estimator: Sync {
     /// in which their exclusions are applied (so a sensor's marginal against
     /// all the others is its contribution to the total).
     fn order_independent(&self) -> bool;
-}
-
-/// Calls `f(dc, dr, cell)` for every on-lattice cell within `t` moves of `start`.
-pub(crate) fn for_reach(s: &Scenario, start: Cell, t: usize, mut f: impl FnMut(i32, i32, Cell)) {
-    let ti = t as i32;
-    for dr in -ti..=ti {
-        for dc in -ti..=ti {
-            let k = Cell {
-                col: start.col + dc,
-                row: start.row + dr,
-            };
-            if s.on_lattice(k) {
-                f(dc, dr, k);
-            }
-        }
-    }
 }

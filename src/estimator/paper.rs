@@ -2,7 +2,7 @@
 
 use super::{Estimator, Target};
 use crate::geometry::Region;
-use crate::scenario::{Cell, MAX_HORIZON, Scenario};
+use crate::scenario::{Cell, Look, MAX_HORIZON, Scenario, all_certain};
 use crate::stats::{Stats, paper_statistical_part};
 
 /// Equations (1) and (2) of the paper, read as follows for the sensor at
@@ -23,44 +23,60 @@ use crate::stats::{Stats, paper_statistical_part};
 ///
 /// Coordination (step 6) multiplies by `1 − f`, `f` the fraction of `F_Pk`'s
 /// area covered by the excluded fields of view.
+///
+/// Sensor types: every term is read with the sensor's own type. `F_Pi`,
+/// `F_Pk`, `κ` and the statistics (`λ̂`, the escape times, `d̂`) are those of
+/// its field of view, and the count is multiplied by its `p_detect`: the
+/// targets it detects are that fraction of those inside. With uncertain
+/// excluded looks, `f` becomes the expected fraction of `F_Pk` they detect,
+/// `∫ 1 − Π (1 − p) / |F_Pk|` (the covered fraction when every `p` is 1).
 pub struct PaperEstimator<'a> {
     scenario: &'a Scenario,
-    stats: &'a Stats,
-    horizon: usize,
+    /// Per field of view (the scenario's `fovs`).
+    stats: &'a [Stats],
     sensors: Vec<PaperSensor>,
 }
 
 struct PaperSensor {
     cell: Cell,
+    ty: usize,
+    /// Offsets of `overlap` reach `±reach` (speed × horizon).
+    reach: i32,
     own: Region,
     statistical: [f64; MAX_HORIZON + 1],
     seen: Vec<Target>,
-    /// `κ` and `|F_k|` by offset from `cell`, `(2T+1)²`, row-major.
+    /// `κ` and `|F_k|` by offset from `cell`, `(2·reach+1)²`, row-major.
     overlap: Vec<(f64, f64)>,
 }
 
 impl<'a> PaperEstimator<'a> {
-    /// Prepares the estimator for sensors at `cells` reporting `targets`,
-    /// for paths of up to `horizon` steps.
+    /// Prepares the estimator for sensors of types `types` at `cells`
+    /// reporting `targets`, for paths of up to `horizon` steps; `stats` per
+    /// field of view (the scenario's `fovs`).
     pub fn new(
         scenario: &'a Scenario,
-        stats: &'a Stats,
+        stats: &'a [Stats],
         cells: &[Cell],
+        types: &[usize],
         targets: &[Target],
         horizon: usize,
     ) -> Self {
-        let h = horizon as i32;
         let sensors = cells
             .iter()
-            .map(|&cell| {
-                let own = scenario.fov_region(cell);
+            .zip(types)
+            .map(|(&cell, &ty)| {
+                let h = (scenario.types[ty].speed * horizon) as i32;
+                let own = scenario.fov_region_of(ty, cell);
                 let mut overlap = Vec::with_capacity(((2 * h + 1) * (2 * h + 1)) as usize);
                 for dr in -h..=h {
                     for dc in -h..=h {
-                        let fk = scenario.fov_region(Cell {
-                            col: cell.col + dc,
-                            row: cell.row + dr,
-                        });
+                        let fk = scenario.fov_region_of(
+                            ty,
+                            Cell {
+                                col: cell.col + dc,
+                                row: cell.row + dr,
+                            },
+                        );
                         let area = fk.area();
                         let kappa = if (dc, dr) == (0, 0) || area <= 0.0 {
                             1.0
@@ -72,6 +88,8 @@ impl<'a> PaperEstimator<'a> {
                 }
                 PaperSensor {
                     cell,
+                    ty,
+                    reach: h,
                     own,
                     statistical: paper_statistical_part(scenario, &own),
                     seen: targets
@@ -86,7 +104,6 @@ impl<'a> PaperEstimator<'a> {
         Self {
             scenario,
             stats,
-            horizon,
             sensors,
         }
     }
@@ -97,11 +114,12 @@ impl Estimator for PaperEstimator<'_> {
         self.scenario
     }
 
-    fn value(&self, sensor: usize, k: Cell, t: usize, excluded: &[Region]) -> f64 {
+    fn value(&self, sensor: usize, k: Cell, t: usize, excluded: &[Look]) -> f64 {
         let me = &self.sensors[sensor];
-        let fk = self.scenario.fov_region(k);
+        let ty = &self.scenario.types[me.ty];
+        let fk = self.scenario.fov_region_of(me.ty, k);
         let (dc, dr) = (k.col - me.cell.col, k.row - me.cell.row);
-        let h = self.horizon as i32;
+        let h = me.reach;
         let (kappa, area) = if dc.abs() <= h && dr.abs() <= h {
             me.overlap[((dr + h) * (2 * h + 1) + dc + h) as usize]
         } else {
@@ -114,12 +132,20 @@ impl Estimator for PaperEstimator<'_> {
             (kappa, area)
         };
         let deterministic = me.seen.iter().filter(|tg| fk.contains(tg.at(t))).count() as f64;
-        let d_hat = self.stats.d_hat[self.scenario.index(k)];
-        let n = deterministic + kappa * me.statistical[t] + (1.0 - kappa) * d_hat;
+        let d_hat = self.stats[ty.fov_slot].d_hat[self.scenario.index(k)];
+        let n = ty.p_detect * (deterministic + kappa * me.statistical[t] + (1.0 - kappa) * d_hat);
         if excluded.is_empty() || area <= 0.0 {
             return n;
         }
-        let f = (fk.covered_area(excluded) / area).clamp(0.0, 1.0);
+        let covered = if all_certain(excluded) {
+            let regions: Vec<Region> = excluded.iter().map(|x| x.region).collect();
+            fk.covered_area(&regions)
+        } else {
+            let looks: Vec<(Region, f64)> =
+                excluded.iter().map(|x| (x.region, x.p_detect)).collect();
+            fk.detected_area(&looks)
+        };
+        let f = (covered / area).clamp(0.0, 1.0);
         n * (1.0 - f)
     }
 

@@ -33,6 +33,19 @@ pub enum ApiError {
     /// No scenario has this id. 404.
     #[error("no scenario with id `{0}`")]
     ScenarioNotFound(String),
+    /// The scenario has no sensor type of this name. 404.
+    #[error("scenario `{scenario}` has no sensor type `{name}` (it has {known})")]
+    SensorTypeNotFound {
+        /// The scenario's id.
+        scenario: String,
+        /// The type asked for.
+        name: String,
+        /// The scenario's type names, comma-separated.
+        known: String,
+    },
+    /// A query parameter could not be decoded. 400.
+    #[error("{0}")]
+    BadQuery(String),
     /// No route matches the path. 404.
     #[error("no resource at `{0}`")]
     RouteNotFound(String),
@@ -95,7 +108,10 @@ impl ApiError {
         match self {
             ApiError::MalformedBody(_) | ApiError::BadPath(_) => StatusCode::BAD_REQUEST,
             ApiError::PayloadTooLarge(_) => StatusCode::PAYLOAD_TOO_LARGE,
-            ApiError::ScenarioNotFound(_) | ApiError::RouteNotFound(_) => StatusCode::NOT_FOUND,
+            ApiError::ScenarioNotFound(_)
+            | ApiError::RouteNotFound(_)
+            | ApiError::SensorTypeNotFound { .. } => StatusCode::NOT_FOUND,
+            ApiError::BadQuery(_) => StatusCode::BAD_REQUEST,
             ApiError::MethodNotAllowed { .. } => StatusCode::METHOD_NOT_ALLOWED,
             ApiError::BuiltinScenario(_) => StatusCode::CONFLICT,
             ApiError::Validation(_) => StatusCode::UNPROCESSABLE_ENTITY,
@@ -115,6 +131,10 @@ impl ApiError {
             ApiError::PayloadTooLarge(_) => ("payload-too-large", "Request body too large"),
             ApiError::ScenarioNotFound(_) => ("scenario-not-found", "Scenario not found"),
             ApiError::RouteNotFound(_) => ("not-found", "Not found"),
+            ApiError::SensorTypeNotFound { .. } => {
+                ("sensor-type-not-found", "Sensor type not found")
+            }
+            ApiError::BadQuery(_) => ("bad-query", "Invalid query parameter"),
             ApiError::MethodNotAllowed { .. } => ("method-not-allowed", "Method not allowed"),
             ApiError::BuiltinScenario(_) => ("builtin-scenario", "Built-in scenario"),
             ApiError::Validation(_) => ("validation", "Invalid request"),

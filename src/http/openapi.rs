@@ -508,6 +508,7 @@ pub mod examples {
     /// field of view of radius 10, one source west of it).
     pub fn stats() -> Value {
         json!({
+            "type": "default",
             "cols": 3,
             "rows": 2,
             "cell_size": 10.0,

@@ -14,7 +14,7 @@ use super::error::ApiError;
 use super::extract::{Json, Path};
 use super::openapi::{self as doc, examples};
 use crate::planner::Planner;
-use crate::scenario::{Scenario, ScenarioSpec};
+use crate::scenario::{DEFAULT_TYPE, Scenario, ScenarioSpec};
 
 /// Size of a scenario's lattice.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
@@ -57,7 +57,7 @@ impl From<&Planner> for ScenarioSummary {
                 rows: p.scenario.rows,
             },
             summary: SummaryStats {
-                expected_targets_in_zone: p.stats.expected_targets_in_zone,
+                expected_targets_in_zone: p.stats[0].expected_targets_in_zone,
                 precompute_ms: p.precompute_ms,
             },
         }
@@ -79,6 +79,9 @@ pub struct ScenarioList {
     description = "Per-cell statistics of a scenario, each array row-major (`row·cols + col`)."
 )]
 pub struct ScenarioStats<'a> {
+    /// The sensor type whose field of view they are for.
+    #[serde(rename = "type")]
+    pub sensor_type: &'a str,
     /// Columns.
     pub cols: i32,
     /// Rows.
@@ -93,17 +96,32 @@ pub struct ScenarioStats<'a> {
     pub d_hat: &'a [f64],
 }
 
-impl<'a> From<&'a Planner> for ScenarioStats<'a> {
-    fn from(p: &'a Planner) -> Self {
+impl<'a> ScenarioStats<'a> {
+    /// The statistics of sensor type `ty`'s field of view.
+    fn of(p: &'a Planner, ty: usize) -> Self {
+        let stats = p.stats_of(ty);
         Self {
+            sensor_type: &p.scenario.types[ty].name,
             cols: p.scenario.cols,
             rows: p.scenario.rows,
             cell_size: p.scenario.cell_size,
-            lambda_hat: &p.stats.lambda_hat,
-            escape_time: &p.stats.escape_time,
-            d_hat: &p.stats.d_hat,
+            lambda_hat: &stats.lambda_hat,
+            escape_time: &stats.escape_time,
+            d_hat: &stats.d_hat,
         }
     }
+}
+
+/// Query of `GET /v1/scenarios/{id}/stats`.
+#[derive(Debug, Clone, Default, Deserialize, utoipa::IntoParams)]
+#[serde(deny_unknown_fields)]
+#[into_params(parameter_in = Query)]
+pub struct StatsQuery {
+    /// The sensor type whose field of view the statistics are for;
+    /// `default` by default.
+    #[serde(rename = "type")]
+    #[param(rename = "type", example = "default")]
+    pub sensor_type: Option<String>,
 }
 
 fn lookup(state: &AppState, id: String) -> Result<Arc<Planner>, ApiError> {
@@ -246,7 +264,7 @@ pub async fn delete(
     summary = "Per-cell statistics of a scenario",
     description = "The precomputed statistics of every cell, row-major (`row·cols + col`). \
         The body has `3·cols·rows` numbers: large for a fine lattice.",
-    params(("id" = String, Path, description = doc::SCENARIO_ID, example = "paper-v10")),
+    params(("id" = String, Path, description = doc::SCENARIO_ID, example = "paper-v10"), StatsQuery),
     responses(
         (status = 200, description = "The statistics.", body = ScenarioStats,
             example = json!(examples::stats())),
@@ -257,10 +275,29 @@ pub async fn delete(
 pub async fn stats(
     State(state): State<AppState>,
     Path(id): Path<String>,
+    uri: axum::http::Uri,
 ) -> Result<Response, ApiError> {
+    let query = axum::extract::Query::<StatsQuery>::try_from_uri(&uri)
+        .map_err(|e| ApiError::BadQuery(e.body_text()))?
+        .0;
     let planner = lookup(&state, id)?;
+    let name = query.sensor_type.as_deref().unwrap_or(DEFAULT_TYPE);
+    let ty = planner
+        .scenario
+        .type_index(name)
+        .ok_or_else(|| ApiError::SensorTypeNotFound {
+            scenario: planner.scenario.id.clone(),
+            name: name.to_owned(),
+            known: planner
+                .scenario
+                .types
+                .iter()
+                .map(|t| t.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+        })?;
     let body = tokio::task::spawn_blocking(move || {
-        serde_json::to_vec(&ScenarioStats::from(planner.as_ref()))
+        serde_json::to_vec(&ScenarioStats::of(planner.as_ref(), ty))
     })
     .await?
     .map_err(|e| ApiError::Internal(format!("serializing statistics: {e}")))?;

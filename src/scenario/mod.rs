@@ -5,14 +5,21 @@
 //! built once by [`Scenario::new`] (parse, don't validate), so the rest of the
 //! crate never re-checks input.
 
+use std::collections::BTreeMap;
+
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use utoipa::ToSchema;
 
 use crate::geometry::{Disk, Point, Rect, Region};
 
+mod sensor;
 mod source;
 
+pub use sensor::{
+    DEFAULT_TYPE, Look, MAX_NO_GO, MAX_SENSOR_SPEED, MAX_SENSOR_TYPES, NoGoSpec, SensorType,
+    SensorTypeSpec, all_certain,
+};
 pub use source::{
     Heading, MAX_SPEED_CLASSES, Source, SourceSpec, SpeedSpec, TargetClass, infer_heading,
 };
@@ -27,6 +34,10 @@ pub const MAX_SOURCES: usize = 64;
 /// over the target classes (the most targets the zone could hold at once if
 /// every one crossed its full diagonal). Keeps every statistic finite.
 pub const MAX_POPULATION: f64 = 1e9;
+/// Most per-cell statistics of a scenario whose sensor types have several
+/// fields of view: cells × distinct fields of view (each field of view has
+/// its own statistics of every cell).
+pub const MAX_CELL_STATS: usize = 8_000_000;
 /// Horizon used when a spec does not give one.
 pub const DEFAULT_HORIZON: usize = 3;
 
@@ -100,8 +111,26 @@ pub struct ScenarioSpec {
     /// Side of a lattice cell; must divide width and height.
     #[schema(exclusive_minimum = 0)]
     pub cell_size: f64,
-    /// Sensors' field of view.
+    /// Field of view of the sensor type `default`.
     pub fov: FovSpec,
+    /// Speed of the type `default`, cells (king moves) per step (1..=3,
+    /// default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<u32>, minimum = 1, maximum = 3)]
+    pub sensor_speed: Option<Integer>,
+    /// Detection probability of the type `default`, in (0, 1] (default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(exclusive_minimum = 0, maximum = 1)]
+    pub p_detect: Option<f64>,
+    /// More sensor types, by name (at most 8; names of 1–32 characters of
+    /// `[A-Za-z0-9_-]`, not `default`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sensor_types: Option<BTreeMap<String, SensorTypeSpec>>,
+    /// Ground no sensor may stand on: a cell whose centre lies in one of
+    /// these rectangles (edges included) is blocked. Targets fly over it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(max_items = 256)]
+    pub no_go: Option<Vec<NoGoSpec>>,
     /// Distance a target flies per step, for the sources that give no
     /// `speeds` (required unless every source gives them).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -142,8 +171,15 @@ pub struct Scenario {
     pub cols: i32,
     /// Rows of the lattice.
     pub rows: i32,
-    /// Field of view.
+    /// Field of view of the type `default` (`types[0].fov`).
     pub fov: FovSpec,
+    /// Sensor types; `types[0]` is `default`, the others follow by name.
+    pub types: Vec<SensorType>,
+    /// The distinct fields of view of the types (`fovs[0]` is `fov`).
+    pub fovs: Vec<FovSpec>,
+    /// Row-major: true for a cell no sensor may stand on. Empty when no
+    /// cell is blocked.
+    blocked: Vec<bool>,
     /// Sources.
     pub sources: Vec<Source>,
     /// Target classes (source × speed), grouped by source in source order.
@@ -278,13 +314,25 @@ impl Scenario {
                 ),
             ));
         }
-        match spec.fov {
-            FovSpec::Square { half_width } => {
-                finite_positive("fov.half_width", half_width)?;
-            }
-            FovSpec::Circle { radius } => {
-                finite_positive("fov.radius", radius)?;
-            }
+        let fleet = sensor::validate_fleet(
+            &spec.fov,
+            spec.sensor_speed.as_ref(),
+            spec.p_detect,
+            spec.sensor_types.as_ref(),
+        )?;
+        let blocked =
+            sensor::blocked_cells(spec.no_go.as_deref().unwrap_or(&[]), cols, rows, cell_size)?;
+        if fleet.fovs.len() > 1
+            && cols as u64 * rows as u64 * fleet.fovs.len() as u64 > MAX_CELL_STATS as u64
+        {
+            return Err(ValidationError::new(
+                "sensor_types",
+                format!(
+                    "{} distinct fields of view on {} cells: at most {MAX_CELL_STATS} cell statistics (cells × fields of view)",
+                    fleet.fovs.len(),
+                    cols as u64 * rows as u64
+                ),
+            ));
         }
         let target_speed = spec
             .target_speed
@@ -331,6 +379,10 @@ impl Scenario {
         let canonical = ScenarioSpec {
             sources: canonical_sources,
             horizon: Some(horizon.into()),
+            sensor_speed: fleet.sensor_speed,
+            p_detect: fleet.p_detect,
+            sensor_types: fleet.sensor_types,
+            no_go: spec.no_go.filter(|v| !v.is_empty()),
             ..spec
         };
         let id = match id {
@@ -346,11 +398,65 @@ impl Scenario {
             cols,
             rows,
             fov: spec.fov,
+            types: fleet.types,
+            fovs: fleet.fovs,
+            blocked,
             sources,
             classes,
             class_offsets,
             horizon,
         })
+    }
+
+    /// The index of the sensor type named `name`.
+    pub fn type_index(&self, name: &str) -> Option<usize> {
+        self.types.iter().position(|t| t.name == name)
+    }
+
+    /// True when no sensor may stand on `c` (a cell on the lattice).
+    #[inline]
+    pub fn is_blocked(&self, c: Cell) -> bool {
+        !self.blocked.is_empty() && self.blocked[self.index(c)]
+    }
+
+    /// True when some cell is blocked.
+    pub fn has_no_go(&self) -> bool {
+        !self.blocked.is_empty()
+    }
+
+    /// True when a sensor may stand on `c`: on the lattice and not blocked.
+    #[inline]
+    pub fn is_free(&self, c: Cell) -> bool {
+        self.on_lattice(c) && !self.is_blocked(c)
+    }
+
+    /// The fastest sensor type's speed, cells per step.
+    pub fn max_sensor_speed(&self) -> usize {
+        self.types.iter().map(|t| t.speed).max().unwrap_or(1)
+    }
+
+    /// True when every type's field of view is a square.
+    pub fn all_square(&self) -> bool {
+        self.fovs
+            .iter()
+            .all(|f| matches!(f, FovSpec::Square { .. }))
+    }
+
+    /// The look of a sensor of type `ty` at cell `c`.
+    #[inline]
+    pub fn look(&self, ty: usize, c: Cell) -> Look {
+        let t = &self.types[ty];
+        Look {
+            region: self.fov_with(t.fov, self.centre(c)),
+            p_detect: t.p_detect,
+        }
+    }
+
+    /// Field of view of a sensor of type `ty` at cell `c`, clipped to the
+    /// zone.
+    #[inline]
+    pub fn fov_region_of(&self, ty: usize, c: Cell) -> Region {
+        self.fov_with(self.types[ty].fov, self.centre(c))
     }
 
     /// The classes of source `j`.
@@ -442,9 +548,15 @@ impl Scenario {
         self.fov_at(self.centre(c))
     }
 
-    /// Field of view of a sensor at point `p`, clipped to the zone.
+    /// Field of view of a `default` sensor at point `p`, clipped to the
+    /// zone.
     pub fn fov_at(&self, p: Point) -> Region {
-        let (half, disk) = match self.fov {
+        self.fov_with(self.fov, p)
+    }
+
+    /// The field of view `fov` at point `p`, clipped to the zone.
+    pub fn fov_with(&self, fov: FovSpec, p: Point) -> Region {
+        let (half, disk) = match fov {
             FovSpec::Square { half_width } => (half_width, None),
             FovSpec::Circle { radius } => (radius, Some(Disk { c: p, r: radius })),
         };
@@ -477,7 +589,7 @@ pub fn derive_id(canonical: &ScenarioSpec) -> String {
 }
 
 /// Names of the built-in scenarios.
-pub const BUILTIN_IDS: [&str; 3] = ["paper-v10", "paper-v15", "site-gates"];
+pub const BUILTIN_IDS: [&str; 4] = ["paper-v10", "paper-v15", "site-gates", "site-fleet"];
 
 /// The paper's setting: a 300×300 zone, 10-unit cells, square FOV of half
 /// width 30, eight sources of rate 0.3 at a third and two thirds of each edge.
@@ -491,6 +603,10 @@ pub fn paper_spec(target_speed: f64) -> ScenarioSpec {
         },
         cell_size: 10.0,
         fov: FovSpec::Square { half_width: 30.0 },
+        sensor_speed: None,
+        p_detect: None,
+        sensor_types: None,
+        no_go: None,
         target_speed: Some(target_speed),
         sources: vec![
             src(-1.0, 100.0),
@@ -540,6 +656,10 @@ pub fn site_gates_spec() -> ScenarioSpec {
         },
         cell_size: 10.0,
         fov: FovSpec::Square { half_width: 30.0 },
+        sensor_speed: None,
+        p_detect: None,
+        sensor_types: None,
+        no_go: None,
         target_speed: None,
         sources: vec![
             SourceSpec {
@@ -565,14 +685,70 @@ pub fn site_gates_spec() -> ScenarioSpec {
     }
 }
 
-/// The built-in scenarios: `paper-v10` and `paper-v15` (the paper's), and
-/// `site-gates` ([`site_gates_spec`]).
+/// The ground robot of `site-fleet`: the paper's 60 m square camera, one
+/// cell per step, and a detection probability of 0.9.
+pub fn site_robot() -> SensorTypeSpec {
+    SensorTypeSpec {
+        fov: FovSpec::Square { half_width: 30.0 },
+        speed: None,
+        p_detect: Some(0.9),
+    }
+}
+
+/// The drone of `site-fleet`: a 100 m square view from altitude, three
+/// cells per step, and a detection probability of 0.6 (smaller targets in
+/// its image).
+pub fn site_drone() -> SensorTypeSpec {
+    SensorTypeSpec {
+        fov: FovSpec::Square { half_width: 50.0 },
+        speed: Some(3.into()),
+        p_detect: Some(0.6),
+    }
+}
+
+/// `site-fleet`: the yard of [`site_gates_spec`] (same gates, cones and
+/// mixes of walkers, cyclists and vehicles), guarded by a mixed fleet
+/// around ground no sensor may enter:
+/// - sensor types `robot` ([`site_robot`]: 60 m view, 1 cell per step,
+///   p_detect 0.9, also the type `default`) and `drone` ([`site_drone`]:
+///   100 m view, 3 cells per step, p_detect 0.6);
+/// - no-go zones: a warehouse in the middle of the yard (x 140–240,
+///   y 100–170), a pond to the north-east (x 290–350, y 200–250) and a
+///   fuel store by the west fence (x 30–70, y 220–270). Drones may not
+///   fly over them either (restricted airspace); targets cross them.
+pub fn site_fleet_spec() -> ScenarioSpec {
+    let rect = |x0, y0, x1, y1| NoGoSpec { x0, y0, x1, y1 };
+    let robot = site_robot();
+    ScenarioSpec {
+        name: Some("site with a fleet of robots and drones around no-go zones".into()),
+        fov: robot.fov,
+        p_detect: robot.p_detect,
+        sensor_types: Some(BTreeMap::from([
+            ("drone".to_owned(), site_drone()),
+            ("robot".to_owned(), robot),
+        ])),
+        no_go: Some(vec![
+            rect(140.0, 100.0, 240.0, 170.0),
+            rect(290.0, 200.0, 350.0, 250.0),
+            rect(30.0, 220.0, 70.0, 270.0),
+        ]),
+        ..site_gates_spec()
+    }
+}
+
+/// The built-in scenarios: `paper-v10` and `paper-v15` (the paper's),
+/// `site-gates` ([`site_gates_spec`]) and `site-fleet` ([`site_fleet_spec`]).
 pub fn builtins() -> Vec<Scenario> {
-    [paper_spec(10.0), paper_spec(15.0), site_gates_spec()]
-        .into_iter()
-        .zip(BUILTIN_IDS)
-        .map(|(spec, id)| Scenario::build(spec, Some(id)).expect("built-in specs are valid"))
-        .collect()
+    [
+        paper_spec(10.0),
+        paper_spec(15.0),
+        site_gates_spec(),
+        site_fleet_spec(),
+    ]
+    .into_iter()
+    .zip(BUILTIN_IDS)
+    .map(|(spec, id)| Scenario::build(spec, Some(id)).expect("built-in specs are valid"))
+    .collect()
 }
 
 #[cfg(test)]

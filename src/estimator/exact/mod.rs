@@ -16,9 +16,9 @@ use seen::RayHits;
 use windows::{StepWindows, Window};
 
 use super::elementary::ElementaryGrid;
-use super::{Estimator, Target, for_reach};
-use crate::geometry::{Point, Region, union_within};
-use crate::scenario::{Cell, FovSpec, Scenario};
+use super::{Estimator, Target};
+use crate::geometry::{Point, Region, detection_within, union_within};
+use crate::scenario::{Cell, Look, Scenario};
 use crate::search::ValueGrid;
 use crate::stats::Stats;
 
@@ -42,6 +42,17 @@ use crate::stats::Stats;
 /// Excluded regions are removed the same way (unshifted), and known targets
 /// (with their own reported velocities) inside them are not counted.
 ///
+/// Detection probabilities: a look detects a target inside it with its
+/// type's `p_detect`, independently of every other look. A target that was
+/// inside looks and never reported is still unseen with probability
+/// `Π (1 − p)` over them, so each ray's seen set carries, piece by piece,
+/// `1 − Π (1 − p)` instead of 1 (see [`seen`]). At the sensor's own cell
+/// a target counts `p_detect` of the sensor, times `Π (1 − p)` over the
+/// excluded looks that hold it: summed in rank order these marginals give
+/// `1 − Π (1 − p)` over the sensors, the chance that at least one detects
+/// it, in any order. Certain looks (`p = 1`) reduce every product to the
+/// union and the exclusion of the paper's sensors.
+///
 /// Two evaluations of the same integral:
 /// - for square fields of view (and cells near a sensor), the seen part is
 ///   accumulated once per sensor and step into the elementary rectangles of
@@ -51,7 +62,8 @@ use crate::stats::Stats;
 /// - otherwise, per cell, by integrating every ray that crosses it.
 pub struct ExactEstimator<'a> {
     scenario: &'a Scenario,
-    stats: &'a Stats,
+    /// Per field of view (the scenario's `fovs`).
+    stats: &'a [Stats],
     rays: &'a [SourceRays],
     grid: Option<&'a ElementaryGrid>,
     known: Vec<Target>,
@@ -62,26 +74,31 @@ pub struct ExactEstimator<'a> {
     seen: Vec<RayHits>,
     /// Sensors' starts, whose windows the fast path uses.
     starts: Vec<Cell>,
+    /// Sensors' types.
+    types: Vec<usize>,
     /// Per step 1..=T: the blocks to accumulate, the window of each (built
     /// on first use), and which block serves each sensor.
     windows: Vec<StepWindows>,
 }
 
 impl<'a> ExactEstimator<'a> {
-    /// Prepares the estimator for sensors starting at `starts` and paths of
-    /// up to `horizon` steps. `observed[s]` are the regions seen `s` steps
-    /// ago (index 0: now). Targets outside the zone are ignored: they have
-    /// left it, or have not entered and cannot have been seen. With `grid`
-    /// (square fields of view) values near the sensors use the fast path.
+    /// Prepares the estimator for sensors of types `types` starting at
+    /// `starts` and paths of up to `horizon` steps. `stats` are the
+    /// scenario's statistics per field of view (its `fovs`), `observed[s]`
+    /// the looks taken `s` steps ago (index 0: now). Targets outside the
+    /// zone are ignored: they have left it, or have not entered and cannot
+    /// have been seen. With `grid` (square fields of view) values near the
+    /// sensors use the fast path.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         scenario: &'a Scenario,
-        stats: &'a Stats,
+        stats: &'a [Stats],
         rays: &'a [SourceRays],
         grid: Option<&'a ElementaryGrid>,
-        observed: &[Vec<Region>],
+        observed: &[Vec<Look>],
         targets: &[Target],
         starts: &[Cell],
+        types: &[usize],
         horizon: usize,
     ) -> Self {
         let classes: Vec<ClassRays> = rays
@@ -103,7 +120,7 @@ impl<'a> ExactEstimator<'a> {
             .map(|c| RayHits::new(&rays[c.rays], observed, c.speed))
             .collect();
 
-        let grid = grid.filter(|_| matches!(scenario.fov, FovSpec::Square { .. }));
+        let grid = grid.filter(|_| scenario.all_square());
         Self {
             scenario,
             stats,
@@ -117,9 +134,10 @@ impl<'a> ExactEstimator<'a> {
             classes,
             seen,
             starts: starts.to_vec(),
+            types: types.to_vec(),
             windows: match grid {
                 Some(grid) => (1..=horizon)
-                    .map(|t| StepWindows::new(grid, scenario, starts, t))
+                    .map(|t| StepWindows::new(grid, scenario, starts, types, t))
                     .collect(),
                 None => Vec::new(),
             },
@@ -151,19 +169,37 @@ impl<'a> ExactEstimator<'a> {
         Some((grid, win))
     }
 
-    /// Known targets at step `t` inside `fk` and outside every excluded region.
-    fn known_in(&self, fk: &Region, t: usize, excluded: &[&Region]) -> f64 {
+    /// Known targets at step `t` inside `fk`, each weighed by the
+    /// probability that every excluded look misses it.
+    fn known_in(&self, fk: &Region, t: usize, excluded: &[&Look]) -> f64 {
         self.known
             .iter()
-            .filter(|tg| {
+            .map(|tg| {
                 let p = tg.at(t);
-                fk.contains(p) && !excluded.iter().any(|x| x.contains(p))
+                if fk.contains(p) {
+                    miss_all(excluded, p)
+                } else {
+                    0.0
+                }
             })
-            .count() as f64
+            .sum()
     }
 
-    /// `U` by integrating every ray that crosses `fk` (the general path).
-    fn unseen_by_rays(&self, k: Cell, fk: &Region, t: usize, excluded: &[&Region]) -> f64 {
+    /// `U` by integrating every ray that crosses `fk` (the general path),
+    /// for the field of view `slot`.
+    fn unseen_by_rays(
+        &self,
+        k: Cell,
+        slot: usize,
+        fk: &Region,
+        t: usize,
+        excluded: &[&Look],
+    ) -> f64 {
+        let d_hat = self.stats[slot].d_hat[self.scenario.index(k)];
+        if !excluded.iter().all(|x| x.p_detect == 1.0) || !self.seen.iter().all(RayHits::certain) {
+            return d_hat - self.detected_by_rays(fk, t, excluded);
+        }
+        let excluded: Vec<&Region> = excluded.iter().map(|x| &x.region).collect();
         let mut buf = Vec::new();
         let mut intervals: Vec<(f64, f64)> = Vec::new();
         let mut seen = 0.0;
@@ -189,7 +225,7 @@ impl<'a> ExactEstimator<'a> {
                         .map(|&(p, q)| (p + lift, q + lift))
                         .filter(|&(p, q)| q > lo && p < hi),
                 );
-                for x in excluded {
+                for x in &excluded {
                     if let Some(iv) = x.ray(sr.source.pos, d, inv) {
                         intervals.push(iv);
                     }
@@ -203,20 +239,77 @@ impl<'a> ExactEstimator<'a> {
         // Not clamped at 0: the midpoint rule may overshoot d̂ by ~1e-6 in a
         // fully seen cell, and clamping would break the additivity that
         // makes marginals sum to the total.
-        self.stats.d_hat[self.scenario.index(k)] - seen
+        d_hat - seen
+    }
+
+    /// The expected targets in `fk` at step `t` that were detected, or that
+    /// an excluded look detects, by the rays: `∫ ρ (1 − Π (1 − p))` with the
+    /// product over the seen pieces and the excluded looks that hold a
+    /// point.
+    fn detected_by_rays(&self, fk: &Region, t: usize, excluded: &[&Look]) -> f64 {
+        let mut buf = Vec::new();
+        let mut intervals: Vec<(f64, f64, f64)> = Vec::new();
+        let mut events = Vec::new();
+        let mut seen = 0.0;
+        for (class, hits) in self.classes.iter().zip(&self.seen) {
+            let sr = &self.rays[class.rays];
+            let lift = class.speed * t as f64;
+            let Some((a, b)) = sr.range(fk, &mut buf) else {
+                continue;
+            };
+            let mut sum = 0.0;
+            for m in a..b {
+                let (iv, detected) = (hits.of(m), hits.detected(m));
+                if excluded.is_empty() && iv.is_empty() {
+                    continue;
+                }
+                let (d, inv) = sr.dirs[m];
+                let Some((lo, hi)) = fk.ray(sr.source.pos, d, inv) else {
+                    continue;
+                };
+                intervals.clear();
+                for (i, &(p, q)) in iv.iter().enumerate() {
+                    if q + lift > lo && p + lift < hi {
+                        let pd = if detected.is_empty() {
+                            1.0
+                        } else {
+                            detected[i]
+                        };
+                        intervals.push((p + lift, q + lift, pd));
+                    }
+                }
+                for x in excluded {
+                    if let Some((p, q)) = x.region.ray(sr.source.pos, d, inv) {
+                        intervals.push((p, q, x.p_detect));
+                    }
+                }
+                if !intervals.is_empty() {
+                    sum += detection_within(&intervals, lo, hi, &mut events);
+                }
+            }
+            seen += class.weight * sum;
+        }
+        seen
     }
 
     /// The same value by the general path, for checks.
-    pub fn value_by_rays(&self, k: Cell, t: usize, excluded: &[Region]) -> f64 {
-        let fk = self.scenario.fov_region(k);
-        let excluded: Vec<&Region> = excluded.iter().filter(|x| x.may_overlap(&fk)).collect();
-        self.known_in(&fk, t, &excluded) + self.unseen_by_rays(k, &fk, t, &excluded)
+    pub fn value_by_rays(&self, sensor: usize, k: Cell, t: usize, excluded: &[Look]) -> f64 {
+        let ty = &self.scenario.types[self.types[sensor]];
+        let fk = self.scenario.fov_region_of(self.types[sensor], k);
+        let excluded: Vec<&Look> = excluded
+            .iter()
+            .filter(|x| x.region.may_overlap(&fk))
+            .collect();
+        ty.p_detect
+            * (self.known_in(&fk, t, &excluded)
+                + self.unseen_by_rays(k, ty.fov_slot, &fk, t, &excluded))
     }
 
     /// The sensor's window at step `t`, when it holds `k`'s block.
     fn block(&self, sensor: usize, k: Cell, t: usize) -> Option<&Window> {
         let (grid, win) = self.window_of(sensor, t)?;
-        let (a0, a1, b0, b1) = grid.span(k);
+        let slot = self.scenario.types[self.types[sensor]].fov_slot;
+        let (a0, a1, b0, b1) = grid.span(slot, k);
         (a0 >= win.a0 && b0 >= win.b0 && a1 <= win.a0 + win.na && b1 <= win.b0 + win.nb)
             .then_some(win)
     }
@@ -231,6 +324,22 @@ struct ClassRays {
     /// `λ_c/(spread·v_c)` times the angular step: targets per unit of ray
     /// length, per ray.
     weight: f64,
+}
+
+/// The probability that every look of `looks` that holds `p` misses a
+/// target there: 1 when none holds it, 0 when a certain one does.
+#[inline]
+fn miss_all(looks: &[&Look], p: Point) -> f64 {
+    let mut miss = 1.0;
+    for x in looks {
+        if x.region.contains(p) {
+            miss *= x.miss();
+            if miss == 0.0 {
+                break;
+            }
+        }
+    }
+    miss
 }
 
 /// The smaller of two numbers that are not NaN (one `minsd`: `f64::min`
@@ -251,53 +360,80 @@ impl Estimator for ExactEstimator<'_> {
         self.scenario
     }
 
-    fn value(&self, sensor: usize, k: Cell, t: usize, excluded: &[Region]) -> f64 {
-        let fk = self.scenario.fov_region(k);
-        let near: Vec<&Region> = excluded.iter().filter(|x| x.may_overlap(&fk)).collect();
+    fn value(&self, sensor: usize, k: Cell, t: usize, excluded: &[Look]) -> f64 {
+        let ty = &self.scenario.types[self.types[sensor]];
+        let fk = self.scenario.fov_region_of(self.types[sensor], k);
+        let near: Vec<&Look> = excluded
+            .iter()
+            .filter(|x| x.region.may_overlap(&fk))
+            .collect();
         let known = self.known_in(&fk, t, &near);
         let (Some(grid), Some(win)) = (self.grid, self.block(sensor, k, t)) else {
-            return known + self.unseen_by_rays(k, &fk, t, &near);
+            return ty.p_detect * (known + self.unseen_by_rays(k, ty.fov_slot, &fk, t, &near));
         };
-        let near: Vec<Region> = near.into_iter().copied().collect();
-        let block = grid.span(k);
+        let near: Vec<Look> = near.into_iter().copied().collect();
+        let block = grid.span(ty.fov_slot, k);
         let unseen = self.block_sums(grid, win, block, &near).sum(block);
-        known + unseen
+        ty.p_detect * (known + unseen)
     }
 
-    fn fill(&self, sensor: usize, start: Cell, t: usize, excluded: &[Region], out: &mut ValueGrid) {
+    fn fill(&self, sensor: usize, start: Cell, t: usize, excluded: &[Look], out: &mut ValueGrid) {
         let s = self.scenario;
         let Some((grid, win)) = self
             .window_of(sensor, t)
             .filter(|_| self.starts.get(sensor) == Some(&start))
         else {
-            for_reach(s, start, t, |dc, dr, k| {
-                out.set(t, dc, dr, self.value(sensor, k, t, excluded))
+            out.fill_step(t, |dc, dr| {
+                let k = Cell {
+                    col: start.col + dc,
+                    row: start.row + dr,
+                };
+                self.value(sensor, k, t, excluded)
             });
             return;
         };
+        let ty = &s.types[self.types[sensor]];
         // Prefix sums of the (masked) unseen mass over the sensor's reach.
-        let ti = t as i32;
-        let (lo, _, blo, _) = grid.span(Cell {
-            col: (start.col - ti).max(0),
-            row: (start.row - ti).max(0),
-        });
-        let (_, hi, _, bhi) = grid.span(Cell {
-            col: (start.col + ti).min(s.cols - 1),
-            row: (start.row + ti).min(s.rows - 1),
-        });
+        let ti = (ty.speed * t) as i32;
+        let (lo, _, blo, _) = grid.span(
+            ty.fov_slot,
+            Cell {
+                col: (start.col - ti).max(0),
+                row: (start.row - ti).max(0),
+            },
+        );
+        let (_, hi, _, bhi) = grid.span(
+            ty.fov_slot,
+            Cell {
+                col: (start.col + ti).min(s.cols - 1),
+                row: (start.row + ti).min(s.rows - 1),
+            },
+        );
         let sums = self.block_sums(grid, win, (lo, hi, blo, bhi), excluded);
-        // Known targets at step t that no excluded region holds.
-        let moved: Vec<Point> = self
+        // Known targets at step t, each with the chance that every excluded
+        // look misses it.
+        let all: Vec<&Look> = excluded.iter().collect();
+        let moved: Vec<(Point, f64)> = self
             .known
             .iter()
             .map(|tg| tg.at(t))
-            .filter(|&p| s.in_zone(p) && !excluded.iter().any(|x| x.contains(p)))
+            .filter(|&p| s.in_zone(p))
+            .map(|p| (p, miss_all(&all, p)))
+            .filter(|&(_, miss)| miss > 0.0)
             .collect();
-        for_reach(s, start, t, |dc, dr, k| {
-            let unseen = sums.sum(grid.span(k));
-            let fk = s.fov_region(k);
-            let known = moved.iter().filter(|&&p| fk.contains(p)).count() as f64;
-            out.set(t, dc, dr, known + unseen);
+        out.fill_step(t, |dc, dr| {
+            let k = Cell {
+                col: start.col + dc,
+                row: start.row + dr,
+            };
+            let unseen = sums.sum(grid.span(ty.fov_slot, k));
+            let fk = s.fov_region_of(self.types[sensor], k);
+            let known: f64 = moved
+                .iter()
+                .filter(|(p, _)| fk.contains(*p))
+                .map(|&(_, miss)| miss)
+                .sum();
+            ty.p_detect * (known + unseen)
         });
     }
 

@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 use crate::estimator::elementary::{ElementaryGrid, trace};
 use crate::geometry::{Point, Region};
-use crate::scenario::{FovSpec, Scenario, Source};
+use crate::scenario::{Scenario, Source};
 use crate::stats::angular_span;
 
 /// Rays per π radians of takeoff angle in the angular grid of each source,
@@ -75,11 +75,13 @@ impl Crossings {
 
 impl SourceRays {
     /// The grids of every source of a scenario with a non-zero rate, at
-    /// [`RAYS_PER_PI_SQUARE`] or [`RAYS_PER_PI`] by its field of view.
+    /// [`RAYS_PER_PI_SQUARE`] when every type's field of view is a square,
+    /// else [`RAYS_PER_PI`].
     pub fn for_scenario(s: &Scenario) -> Vec<SourceRays> {
-        let density = match s.fov {
-            FovSpec::Square { .. } => RAYS_PER_PI_SQUARE,
-            FovSpec::Circle { .. } => RAYS_PER_PI,
+        let density = if s.all_square() {
+            RAYS_PER_PI_SQUARE
+        } else {
+            RAYS_PER_PI
         };
         Self::with_density(s, density)
     }

@@ -1,23 +1,140 @@
-//! Seen sets along rays: for each ray of a source, the union of what the
-//! sensors' fields of view covered now and in the history, each interval
-//! pushed by the distance a target has flown since.
+//! Seen sets along rays: for each ray of a source, what the sensors' looks
+//! covered now and in the history, each interval pushed by the distance a
+//! target has flown since.
+//!
+//! With looks that detect with certainty (the paper's sensors) a seen set
+//! is a union of intervals. With detection probabilities below 1 it is, per
+//! piece of the ray, the probability `1 − Π (1 − p)` over the looks that
+//! held the piece that a target there was detected: a target that stayed
+//! unreported is still in the zone with the rest of that probability.
 
 use super::rays::SourceRays;
 use super::{max, min};
 use crate::geometry::Region;
+use crate::scenario::{Look, all_certain};
 
 /// What the rays of one source saw: per ray, the union of the intervals
 /// seen `s` steps ago, each pushed by `v·s` (the distance a target has flown
 /// since), merged into sorted disjoint intervals. At step `t` the seen set is
-/// the same union pushed a further `v·t`. Stored compactly, ray by ray.
+/// the same union pushed a further `v·t`. Stored compactly, ray by ray; with
+/// uncertain looks each interval also carries the probability that a target
+/// in it was detected.
 pub(super) struct RayHits {
     /// `hits[offsets[m]..offsets[m+1]]` are ray `m`'s intervals.
     offsets: Vec<u32>,
     hits: Vec<(f64, f64)>,
+    /// Aligned with `hits`: the detection probability of each interval.
+    /// Empty when every look is certain (every interval's is 1).
+    detected: Vec<f64>,
 }
 
 impl RayHits {
-    pub(super) fn new(sr: &SourceRays, observed: &[Vec<Region>], speed: f64) -> Self {
+    pub(super) fn new(sr: &SourceRays, observed: &[Vec<Look>], speed: f64) -> Self {
+        if observed.iter().all(|step| all_certain(step)) {
+            let regions: Vec<Vec<Region>> = observed
+                .iter()
+                .map(|step| step.iter().map(|l| l.region).collect())
+                .collect();
+            Self::union(sr, &regions, speed)
+        } else {
+            Self::weighted(sr, observed, speed)
+        }
+    }
+
+    /// Seen sets of uncertain looks: every look's interval on every ray it
+    /// crosses, then per ray a sweep that cuts them into disjoint pieces
+    /// with their detection probability.
+    fn weighted(sr: &SourceRays, observed: &[Vec<Look>], speed: f64) -> Self {
+        let mut buf = Vec::new();
+        let o = sr.source.pos;
+        let n = sr.dirs.len();
+        let mut pieces: Vec<(u32, f64, f64, f64)> = Vec::new();
+        for (s, looks) in observed.iter().enumerate() {
+            let shift = speed * s as f64;
+            for look in looks {
+                let Some((a, b)) = sr.range(&look.region, &mut buf) else {
+                    continue;
+                };
+                for m in a..b {
+                    let (d, inv) = sr.dirs[m];
+                    if let Some((p, q)) = look.region.ray(o, d, inv) {
+                        pieces.push((m as u32, p + shift, q + shift, look.p_detect));
+                    }
+                }
+            }
+        }
+        pieces.sort_unstable_by(|x, y| x.0.cmp(&y.0));
+        let mut offsets = vec![0u32; n + 1];
+        let mut hits: Vec<(f64, f64)> = Vec::new();
+        let mut detected: Vec<f64> = Vec::new();
+        let mut events: Vec<(f64, f64, bool)> = Vec::new();
+        let mut i = 0;
+        for m in 0..n {
+            let start = i;
+            while i < pieces.len() && pieces[i].0 as usize == m {
+                i += 1;
+            }
+            events.clear();
+            for &(_, p, q, pd) in &pieces[start..i] {
+                if q > p {
+                    events.push((p, pd, true));
+                    events.push((q, pd, false));
+                }
+            }
+            events.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+            let (mut open, mut certain, mut log_miss) = (0usize, 0usize, 0.0f64);
+            let mut prev = f64::NEG_INFINITY;
+            for &(x, pd, opens) in &events {
+                if open > 0 && x > prev {
+                    let seen = if certain > 0 {
+                        1.0
+                    } else {
+                        1.0 - log_miss.exp()
+                    };
+                    // A piece that continues the last one of this ray at
+                    // the same probability extends it.
+                    let ours = hits.len() > offsets[m] as usize;
+                    match (hits.last_mut(), detected.last()) {
+                        (Some(last), Some(&d)) if ours && last.1 == prev && d == seen => {
+                            last.1 = x;
+                        }
+                        _ => {
+                            hits.push((prev, x));
+                            detected.push(seen);
+                        }
+                    }
+                }
+                prev = x;
+                if opens {
+                    open += 1;
+                } else {
+                    open -= 1;
+                }
+                if pd >= 1.0 {
+                    if opens {
+                        certain += 1;
+                    } else {
+                        certain -= 1;
+                    }
+                } else {
+                    let l = (-pd).ln_1p();
+                    log_miss += if opens { l } else { -l };
+                }
+                if open == 0 {
+                    log_miss = 0.0;
+                }
+            }
+            offsets[m + 1] = hits.len() as u32;
+        }
+        RayHits {
+            offsets,
+            hits,
+            detected,
+        }
+    }
+
+    /// Seen sets of certain looks: unions of intervals.
+    fn union(sr: &SourceRays, observed: &[Vec<Region>], speed: f64) -> Self {
         let mut buf = Vec::new();
         let n = sr.dirs.len();
         let o = sr.source.pos;
@@ -107,13 +224,34 @@ impl RayHits {
             }
             offsets[m + 1] = hits.len() as u32;
         }
-        RayHits { offsets, hits }
+        RayHits {
+            offsets,
+            hits,
+            detected: Vec::new(),
+        }
     }
 
     /// Ray `m`'s seen intervals (sorted, disjoint) as of step 0.
     #[inline]
     pub(super) fn of(&self, m: usize) -> &[(f64, f64)] {
         &self.hits[self.offsets[m] as usize..self.offsets[m + 1] as usize]
+    }
+
+    /// The detection probabilities of ray `m`'s intervals, aligned with
+    /// [`RayHits::of`]; empty when every look was certain.
+    #[inline]
+    pub(super) fn detected(&self, m: usize) -> &[f64] {
+        if self.detected.is_empty() {
+            &[]
+        } else {
+            &self.detected[self.offsets[m] as usize..self.offsets[m + 1] as usize]
+        }
+    }
+
+    /// True when every look was certain.
+    #[inline]
+    pub(super) fn certain(&self) -> bool {
+        self.detected.is_empty()
     }
 }
 

@@ -11,7 +11,7 @@ use super::seen::RayHits;
 use super::{ExactEstimator, max, min};
 use crate::estimator::elementary::{Block, ElementaryGrid, trace};
 use crate::geometry::{Point, Region};
-use crate::scenario::{Cell, Scenario};
+use crate::scenario::{Cell, Look, Scenario};
 
 /// Prefix sums over a block of rectangles.
 pub(super) struct BlockSums {
@@ -40,11 +40,19 @@ pub(super) struct StepWindows {
 }
 
 impl StepWindows {
-    pub(super) fn new(grid: &ElementaryGrid, s: &Scenario, starts: &[Cell], t: usize) -> Self {
-        let ti = t as i32;
+    pub(super) fn new(
+        grid: &ElementaryGrid,
+        s: &Scenario,
+        starts: &[Cell],
+        types: &[usize],
+        t: usize,
+    ) -> Self {
         let reach: Vec<Block> = starts
             .iter()
-            .map(|start| {
+            .zip(types)
+            .map(|(start, &ty)| {
+                let ti = (s.types[ty].speed * t) as i32;
+                let slot = s.types[ty].fov_slot;
                 let lo = Cell {
                     col: (start.col - ti).max(0),
                     row: (start.row - ti).max(0),
@@ -53,8 +61,8 @@ impl StepWindows {
                     col: (start.col + ti).min(s.cols - 1),
                     row: (start.row + ti).min(s.rows - 1),
                 };
-                let (a0, _, b0, _) = grid.span(lo);
-                let (_, a1, _, b1) = grid.span(hi);
+                let (a0, _, b0, _) = grid.span(slot, lo);
+                let (_, a1, _, b1) = grid.span(slot, hi);
                 (a0, a1, b0, b1)
             })
             .collect();
@@ -185,13 +193,19 @@ impl ExactEstimator<'_> {
                 if hits.is_empty() || lin.is_empty() {
                     continue;
                 }
+                let detected = seen.detected(m);
                 let end = rs[lin.len()] - lift;
                 let from = hits.partition_point(|&(_, q)| q + lift <= rs[0]);
                 let mut k = usize::MAX;
-                for &(p, q) in &hits[from..] {
+                for (i, &(p, q)) in hits.iter().enumerate().skip(from) {
                     if p >= end {
                         break;
                     }
+                    let w = if detected.is_empty() {
+                        w
+                    } else {
+                        w * detected[i]
+                    };
                     let (p, q) = (p + lift, q + lift);
                     k = next_crossing(rs, k, p);
                     while k < lin.len() && rs[k] < q {
@@ -222,6 +236,14 @@ impl ExactEstimator<'_> {
             if hits.is_empty() {
                 continue;
             }
+            let detected = seen.detected(m);
+            let weight = |i: usize| {
+                if detected.is_empty() {
+                    w
+                } else {
+                    w * detected[i]
+                }
+            };
             let (d, inv) = sr.dirs[m];
             let Some((wa, wb)) = region.ray(sr.source.pos, d, inv) else {
                 continue;
@@ -230,10 +252,11 @@ impl ExactEstimator<'_> {
             let (wa, wb) = (wa - lift, wb - lift);
             let from = hits.partition_point(|&(_, q)| q <= wa);
             let Some(cr) = &sr.crossings else {
-                for &(p, q) in &hits[from..] {
+                for (i, &(p, q)) in hits.iter().enumerate().skip(from) {
                     if p >= wb {
                         break;
                     }
+                    let w = weight(i);
                     let (p, q) = (max(p, wa) + lift, min(q, wb) + lift);
                     if q > p {
                         walk(grid, block, acc, sr.source.pos, d, inv, p, q, w);
@@ -243,10 +266,11 @@ impl ExactEstimator<'_> {
             };
             let (rs, cells, _) = cr.of(m);
             let mut k = usize::MAX;
-            for &(p, q) in &hits[from..] {
+            for (i, &(p, q)) in hits.iter().enumerate().skip(from) {
                 if p >= wb {
                     break;
                 }
+                let w = weight(i);
                 let (p, q) = (max(p, wa) + lift, min(q, wb) + lift);
                 if q <= p {
                     continue;
@@ -267,14 +291,15 @@ impl ExactEstimator<'_> {
     }
 
     /// Prefix sums of the unseen mass over `block` (global indices, inside
-    /// the window), leaving out the rectangles of excluded regions (fields
-    /// of view are unions of rectangles: those whose centre they contain).
+    /// the window), each rectangle times the probability that every
+    /// excluded look misses it (fields of view are unions of rectangles:
+    /// those whose centre they contain); a certain look leaves it out.
     pub(super) fn block_sums(
         &self,
         grid: &ElementaryGrid,
         win: &Window,
         block: Block,
-        excluded: &[Region],
+        excluded: &[Look],
     ) -> BlockSums {
         let (a0, a1, b0, b1) = block;
         let w = a1 - a0 + 1;
@@ -284,17 +309,25 @@ impl ExactEstimator<'_> {
             .collect();
         for (j, b) in (b0..b1).enumerate() {
             let yc = 0.5 * (grid.ys[b] + grid.ys[b + 1]);
-            let rows: Vec<&Region> = excluded
+            let rows: Vec<&Look> = excluded
                 .iter()
-                .filter(|x| yc >= x.rect.y0 && yc <= x.rect.y1)
+                .filter(|x| yc >= x.region.rect.y0 && yc <= x.region.rect.y1)
                 .collect();
             let mut row = 0.0;
             for (i, a) in (a0..a1).enumerate() {
-                if !rows
-                    .iter()
-                    .any(|x| xc[i] >= x.rect.x0 && xc[i] <= x.rect.x1)
-                {
+                let mut miss = 1.0;
+                for x in &rows {
+                    if xc[i] >= x.region.rect.x0 && xc[i] <= x.region.rect.x1 {
+                        miss *= x.miss();
+                        if miss == 0.0 {
+                            break;
+                        }
+                    }
+                }
+                if miss == 1.0 {
                     row += win.unseen[(b - win.b0) * win.na + (a - win.a0)];
+                } else if miss > 0.0 {
+                    row += miss * win.unseen[(b - win.b0) * win.na + (a - win.a0)];
                 }
                 prefix[(j + 1) * w + i + 1] = prefix[j * w + i + 1] + row;
             }
