@@ -231,7 +231,9 @@ fn exact_estimator_is_unbiased_with_uncertain_looks_of_mixed_types() {
     let probes: Vec<Probe> = probes()
         .into_iter()
         .map(|p| Probe {
-            excluded: p.excluded.map(|(ty, c)| (if ty == 1 { wide } else { ty }, c)),
+            excluded: p
+                .excluded
+                .map(|(ty, c)| (if ty == 1 { wide } else { ty }, c)),
             ..p
         })
         .collect();
@@ -257,7 +259,9 @@ fn exact_estimator_is_unbiased_on_the_general_path() {
     let probes: Vec<Probe> = probes()
         .into_iter()
         .map(|p| Probe {
-            excluded: p.excluded.map(|(ty, c)| (if ty == 1 { disk } else { ty }, c)),
+            excluded: p
+                .excluded
+                .map(|(ty, c)| (if ty == 1 { disk } else { ty }, c)),
             ..p
         })
         .collect();
@@ -272,7 +276,11 @@ fn exact_estimator_is_unbiased_on_the_general_path() {
 fn treating_uncertain_looks_as_certain_is_detected_as_biased() {
     let truth = Scenario::new(fleet_spec(false)).expect("valid");
     let types = [0, 0, 0];
-    let track = |_s_ago: usize| [(9, 9), (12, 10), (21, 19)].map(|(c, r)| cell(c, r)).to_vec();
+    let track = |_s_ago: usize| {
+        [(9, 9), (12, 10), (21, 19)]
+            .map(|(c, r)| cell(c, r))
+            .to_vec()
+    };
     let probes = vec![
         Probe {
             sensor: 0,
@@ -394,10 +402,12 @@ fn fast_and_general_paths_agree_with_mixed_types() {
     let wide = s.type_index("wide").expect("wide");
     for round in 0..3 {
         let starts: Vec<Cell> = (0..4)
-            .map(|_| loop {
-                let c = cell(rng.random_range(0..s.cols), rng.random_range(0..s.rows));
-                if s.is_free(c) {
-                    break c;
+            .map(|_| {
+                loop {
+                    let c = cell(rng.random_range(0..s.cols), rng.random_range(0..s.rows));
+                    if s.is_free(c) {
+                        break c;
+                    }
                 }
             })
             .collect();
@@ -408,10 +418,7 @@ fn fast_and_general_paths_agree_with_mixed_types() {
                     .iter()
                     .zip(types)
                     .map(|(c, ty)| {
-                        s.look(
-                            ty,
-                            cell((c.col + h).min(s.cols - 1), (c.row - h).max(0)),
-                        )
+                        s.look(ty, cell((c.col + h).min(s.cols - 1), (c.row - h).max(0)))
                     })
                     .collect()
             })

@@ -56,6 +56,26 @@ UNSCHEMATISABLE = [
         "a position must lie in the zone of the scenario named by the path or body",
     ),
     (
+        r"^(sensors\[\d+\]|history\[\d+\]\[\d+\])\.type: unknown sensor type",
+        "a name must be one of the sensor types of the scenario named by the path or body",
+    ),
+    (
+        r"^(sensors\[\d+\]|history\[\d+\]\[\d+\]): cell .* is in a no-go zone",
+        "a position must lie outside the no-go rectangles of the scenario named by the path or body",
+    ),
+    (
+        r"^(scenario\.)?no_go\[\d+\]: [xy]0 must be < [xy]1",
+        "a relation between two numbers (a rectangle's two edges)",
+    ),
+    (
+        r"^(scenario\.)?sensor_types\.default: ",
+        "one reserved name among a map's keys (`default` is the top-level fov)",
+    ),
+    (
+        r"^(scenario\.)?sensor_types: .* distinct fields of view on .* cells",
+        "a bound on a product (cells × distinct fields of view among the map's values)",
+    ),
+    (
         r"^sensors\[\d+\]\.id: duplicate sensor id",
         "uniqueness of one property across array items (uniqueItems compares whole items)",
     ),

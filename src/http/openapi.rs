@@ -21,7 +21,7 @@ use crate::coordination::Coordination;
 use crate::planner::{
     EstimatorKind, MAX_HISTORY_POSITIONS, Observed, PositionIn, SensorIn, TargetIn,
 };
-use crate::scenario::{Integer, ScenarioSpec, ValidationError};
+use crate::scenario::{Integer, MAX_SENSOR_TYPES, ScenarioSpec, ValidationError};
 
 /// Description of the whole API, the `info.description` of the document.
 const DESCRIPTION: &str = "\
@@ -267,6 +267,19 @@ impl Modify for Closed {
                         Some(Box::new(AdditionalProperties::FreeForm(false)));
                 }
             }
+        }
+        // Sensor type names: a pattern and a count utoipa's derive cannot
+        // state on a map.
+        if let Some(RefOr::T(Schema::Object(spec))) = components.schemas.get_mut("ScenarioSpec")
+            && let Some(RefOr::T(Schema::Object(types))) = spec.properties.get_mut("sensor_types")
+        {
+            types.max_properties = Some(MAX_SENSOR_TYPES);
+            types.property_names = Some(Box::new(Schema::Object(
+                utoipa::openapi::schema::ObjectBuilder::new()
+                    .schema_type(utoipa::openapi::schema::Type::String)
+                    .pattern(Some("^[A-Za-z0-9_-]{1,32}$"))
+                    .build(),
+            )));
         }
         for name in ["PlanRequest", "PlanRequestById", "PlanRequestWithScenario"] {
             let Some(RefOr::T(Schema::Object(object))) = components.schemas.get_mut(name) else {

@@ -100,7 +100,7 @@ pub enum FovSpec {
 /// A scenario as clients send it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
-#[schema(examples(json!(paper_spec(10.0)), json!(site_gates_spec())))]
+#[schema(examples(json!(paper_spec(10.0)), json!(site_gates_spec()), json!(site_fleet_spec())))]
 pub struct ScenarioSpec {
     /// Free-form label.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -4,6 +4,7 @@
 #![allow(clippy::unwrap_used)]
 
 mod errors;
+mod fleet;
 mod fuzz;
 mod helpers;
 mod openapi;
