@@ -429,8 +429,9 @@ impl Planner {
 
     /// Approximate heap memory held, bytes (for cache bounds).
     pub fn memory_bytes(&self) -> usize {
-        let stats = 3 * self.stats.len() * self.scenario.cell_count() * std::mem::size_of::<f64>()
-            + self.scenario.cell_count();
+        let cells = self.scenario.cell_count();
+        let blocked = if self.scenario.has_no_go() { cells } else { 0 };
+        let stats = 3 * self.stats.len() * cells * std::mem::size_of::<f64>() + blocked;
         let grid = self.grid.as_ref().map_or(0, ElementaryGrid::memory_bytes);
         let rays: usize = self.rays.iter().map(SourceRays::memory_bytes).sum();
         std::mem::size_of::<Self>() + stats + grid + rays

@@ -593,3 +593,60 @@ fn reachable_in_one_step(s: &Scenario, from: Cell, to: Cell, speed: usize) -> bo
     }
     seen.contains(&to)
 }
+
+/// The paper estimator reads a type's statistics and scales by its
+/// `p_detect`: a sensor of a type with the `default` field of view and
+/// `p_detect` ½ has exactly half the search values of a `default` one.
+#[test]
+fn paper_estimator_scales_by_p_detect() {
+    let mut spec = paper_spec(10.0);
+    spec.sensor_types = Some(BTreeMap::from([(
+        "half".to_owned(),
+        SensorTypeSpec {
+            fov: spec.fov,
+            speed: None,
+            p_detect: Some(0.5),
+        },
+    )]));
+    let planner = Planner::new(Scenario::new(spec).expect("valid"));
+    let explain = |ty: Option<&str>| {
+        let req = PlanRequest {
+            sensors: vec![SensorIn {
+                id: Id::Number(1.into()),
+                x: 155.0,
+                y: 145.0,
+                sensor_type: ty.map(str::to_owned),
+            }],
+            targets: vec![TargetIn {
+                id: None,
+                x: 150.0,
+                y: 150.0,
+                vx: 10.0,
+                vy: 0.0,
+            }],
+            estimator: Some(vigil::planner::EstimatorKind::Paper),
+            explain: Some(true),
+            ..Default::default()
+        };
+        let resp = planner.plan_request(&req).expect("valid");
+        resp.plans[0].explain.clone().expect("explain").values
+    };
+    let (full, half) = (explain(None), explain(Some("half")));
+    let mut compared = 0;
+    for (a, b) in full
+        .iter()
+        .flatten()
+        .flatten()
+        .zip(half.iter().flatten().flatten())
+    {
+        match (a, b) {
+            (Some(a), Some(b)) => {
+                assert!((0.5 * a - b).abs() < 1e-12, "{a} vs {b}");
+                compared += 1;
+            }
+            (None, None) => {}
+            _ => panic!("reachability differs"),
+        }
+    }
+    assert!(compared > 50);
+}
