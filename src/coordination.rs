@@ -122,7 +122,7 @@ pub fn coordinate(
                                 col: starts[i].col + dc,
                                 row: starts[i].row + dr,
                             };
-                            total_change(s, est, &plans, types, &order, rank, k, t)
+                            Some(total_change(s, est, &plans, types, &order, rank, k, t))
                         });
                     })
                 };

@@ -1,15 +1,46 @@
-//! The best T-step path of one sensor on the 9-connected space-time lattice.
+//! The best T-step path of one sensor: dynamic programming over the
+//! space-time lattice.
 //!
-//! The paper runs a depth-limited search over the `9^T` move sequences. The
-//! value of a path is a sum of per-(cell, step) values, so dynamic
-//! programming over (offset, step) finds the same optimum in
-//! `O(T·(2T+1)²·9)`: `best[t][o] = v[t][o] + max over the 9 moves m of
-//! best[t+1][o+m]`, then one forward pass picks the moves.
+//! # Motion model
 //!
-//! Ties are broken deterministically: among optimal paths the one whose move
-//! sequence comes first in [`MOVES`] order (stay first), compared move by
-//! move from step 1. [`brute_force`] enumerates in the same order, so both
-//! return the same path when sums are exact.
+//! A sensor of speed `m` (1 ≤ `m` ≤ [`MAX_SPEED`]) makes, in one step, up to
+//! `m` king moves (each to one of its 8 neighbours); every intermediate and
+//! final cell must be *free*, that is on the lattice and not blocked. The
+//! offsets reachable in one step from offset `o` are therefore those within
+//! breadth-first distance `m` of `o` in the 8-connected graph of free cells;
+//! the displacement is at most `m` in each coordinate. The sensor's start,
+//! offset `(0, 0)`, is always free, and so is every offset it can reach, so
+//! staying put is always a legal step. [`ValueGrid::new`] is the paper's
+//! case: speed 1, every cell free; [`ValueGrid::with_motion`] takes the speed
+//! and the free cells.
+//!
+//! A path is a sequence of `T` legal steps whose final cells all have a value
+//! in the [`ValueGrid`]; its value is the sum of those values, in step order.
+//! Intermediate cells of a multi-move step only need to be free: they need
+//! no value.
+//!
+//! # Algorithm
+//!
+//! The paper runs a depth-limited search over the `9^T` move sequences
+//! ([`brute_force`] is that search, generalised to `(2m+1)²` displacements
+//! per step). The value of a path is a sum of per-(cell, step) values, so
+//! dynamic programming over the space-time lattice of (offset, step) pairs
+//! finds the same optimum in `O(T·(2mT+1)²·(2m+1)²)`:
+//! `best[t][o] = v[t][o] + max over the legal one-step successors o' of o of
+//! best[t+1][o']`, then one forward pass picks the steps. The grid
+//! precomputes, once per horizon, speed and free mask, which offsets are
+//! reachable at each step and each offset's successor list (speed 1 with
+//! every cell free, the planner's case, is cached per thread, so building a
+//! grid costs one allocation).
+//!
+//! # Tie-breaking
+//!
+//! Ties are broken deterministically: among optimal paths, the one whose
+//! displacement sequence comes first in [`step_displacements`] order (stay
+//! first, then by Chebyshev ring, then `dr`, then `dc`; [`MOVES`] for speed
+//! 1), compared step by step from step 1. [`brute_force`] enumerates in the
+//! same order and keeps the first strictly better path, so both return the
+//! same path (moves and value) whenever sums are exact.
 //!
 //! ```
 //! use vigil::search::{ValueGrid, best_path};
@@ -22,7 +53,12 @@
 //! assert_eq!(best.value, 5.0);
 //! ```
 
-/// The nine moves `(dc, dr)` of one step, in tie-breaking order.
+use std::cell::RefCell;
+use std::fmt;
+use std::sync::Arc;
+
+/// The nine moves `(dc, dr)` of one step at speed 1, in tie-breaking order
+/// (the same as `step_displacements(1)`).
 pub const MOVES: [(i32, i32); 9] = [
     (0, 0),
     (-1, -1),
@@ -35,75 +71,390 @@ pub const MOVES: [(i32, i32); 9] = [
     (1, 1),
 ];
 
-/// Values of the cells a sensor can occupy, by step and offset from its
-/// start. A missing value (`None`) marks a cell that is off the lattice.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ValueGrid {
-    horizon: usize,
-    side: usize,
-    values: Vec<Option<f64>>,
-    free: Option<Vec<bool>>,
+/// The largest supported speed (king moves per step).
+pub const MAX_SPEED: usize = 3;
+
+/// The `N = (2m+1)²` displacements of speed `m` in tie-breaking order: by
+/// Chebyshev ring (stay first), then `dr` ascending, then `dc` ascending.
+const fn ring_order<const N: usize>(m: i32) -> [(i32, i32); N] {
+    let mut out = [(0, 0); N];
+    let mut i = 0;
+    let mut k = 0;
+    while k <= m {
+        let mut dr = -k;
+        while dr <= k {
+            let mut dc = -k;
+            while dc <= k {
+                let ring = if dc.abs() > dr.abs() {
+                    dc.abs()
+                } else {
+                    dr.abs()
+                };
+                if ring == k {
+                    out[i] = (dc, dr);
+                    i += 1;
+                }
+                dc += 1;
+            }
+            dr += 1;
+        }
+        k += 1;
+    }
+    assert!(i == N);
+    out
 }
 
-impl ValueGrid {
-    /// An empty grid (every cell missing) for horizon `horizon ≥ 1`.
-    pub fn new(horizon: usize) -> Self {
-        let side = 2 * horizon + 1;
+static STEPS_1: [(i32, i32); 9] = ring_order(1);
+static STEPS_2: [(i32, i32); 25] = ring_order(2);
+static STEPS_3: [(i32, i32); 49] = ring_order(3);
+
+/// Every displacement `(dc, dr)` with `max(|dc|, |dr|) ≤ speed`, in
+/// tie-breaking order: by Chebyshev ring (stay first), then `dr` ascending,
+/// then `dc` ascending. For speed 1 this is [`MOVES`].
+///
+/// # Panics
+///
+/// If `speed` is not in `1..=MAX_SPEED`.
+pub fn step_displacements(speed: usize) -> &'static [(i32, i32)] {
+    match speed {
+        1 => &STEPS_1,
+        2 => &STEPS_2,
+        3 => &STEPS_3,
+        _ => panic!("speed {speed} is not in 1..={MAX_SPEED}"),
+    }
+}
+
+/// First step of an offset that is never reachable.
+const NEVER: u32 = u32::MAX;
+
+/// The reachability tables of one (horizon, speed, free mask), shared by the
+/// grids built with them.
+#[derive(PartialEq, Eq)]
+struct Motion {
+    speed: usize,
+    horizon: usize,
+    side: usize,
+    /// Every offset free.
+    open: bool,
+    /// Per offset (row-major, `(dr+mT)·side + dc+mT`), the first step at which
+    /// it is reachable, [`NEVER`] if none. Reachability is monotone in the
+    /// step (staying is legal), so reachable at `t` ⇔ `first ≤ t`.
+    first: Vec<u32>,
+    /// Per offset reachable before step T, its legal one-step displacements
+    /// as bits `(dr+m)·(2m+1) + dc+m`; 0 elsewhere.
+    steps: Vec<u64>,
+    /// `succ[succ_start[o]..succ_start[o+1]]`: the offsets one legal step
+    /// from `o`, in displacement order (so `o` itself first).
+    succ_start: Vec<u32>,
+    succ: Vec<u32>,
+}
+
+impl fmt::Debug for Motion {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Motion")
+            .field("speed", &self.speed)
+            .field("horizon", &self.horizon)
+            .field("side", &self.side)
+            .finish_non_exhaustive()
+    }
+}
+
+/// The cells of a `(2m+1)²` window, as bits `r·w + c`, dilated by one king
+/// move (clipped to the window).
+fn dilate(x: u64, w: u32) -> u64 {
+    let full = (1u64 << (w * w)) - 1;
+    let col0 = (0..w).fold(0u64, |a, r| a | 1 << (r * w));
+    let last = col0 << (w - 1);
+    let h = x | ((x << 1) & !col0) | ((x >> 1) & !last);
+    (h | (h << w) | (h >> w)) & full
+}
+
+impl Motion {
+    /// Builds the tables from the free mask (row-major over the
+    /// `side × side` offsets, the start included and free).
+    fn build(speed: usize, horizon: usize, free: &[bool]) -> Self {
+        let side = 2 * speed * horizon + 1;
+        let n = side * side;
+        let e = speed * horizon;
+        let start = e * side + e;
+        let m = speed as i32;
+        let w = 2 * speed as u32 + 1;
+        let disps = step_displacements(speed);
+        let mut first = vec![NEVER; n];
+        let mut steps = vec![0u64; n];
+        first[start] = 0;
+        let mut frontier = vec![start];
+        for t in 1..=horizon {
+            let mut next = Vec::new();
+            for &o in &frontier {
+                let (r, c) = ((o / side) as i32, (o % side) as i32);
+                // The free cells of the window around o.
+                let mut win = 0u64;
+                for dr in -m..=m {
+                    for dc in -m..=m {
+                        let (rr, cc) = (r + dr, c + dc);
+                        if (0..side as i32).contains(&rr)
+                            && (0..side as i32).contains(&cc)
+                            && free[rr as usize * side + cc as usize]
+                        {
+                            win |= 1 << ((dr + m) as u32 * w + (dc + m) as u32);
+                        }
+                    }
+                }
+                // Breadth-first search to depth m, as m dilations.
+                let mut reach = 1u64 << (speed as u32 * w + speed as u32);
+                for _ in 0..speed {
+                    reach = dilate(reach, w) & win;
+                }
+                steps[o] = reach;
+                for &(dc, dr) in disps {
+                    if reach >> ((dr + m) as u32 * w + (dc + m) as u32) & 1 == 1 {
+                        let o2 = ((r + dr) * side as i32 + c + dc) as usize;
+                        if first[o2] == NEVER {
+                            first[o2] = t as u32;
+                            next.push(o2);
+                        }
+                    }
+                }
+            }
+            frontier = next;
+        }
+        let mut succ_start = Vec::with_capacity(n + 1);
+        let mut succ = Vec::new();
+        for (o, &mask) in steps.iter().enumerate() {
+            succ_start.push(succ.len() as u32);
+            if mask == 0 {
+                continue;
+            }
+            for &(dc, dr) in disps {
+                if mask >> ((dr + m) as u32 * w + (dc + m) as u32) & 1 == 1 {
+                    succ.push((o as i32 + dr * side as i32 + dc) as u32);
+                }
+            }
+        }
+        succ_start.push(succ.len() as u32);
         Self {
+            speed,
             horizon,
             side,
-            values: vec![None; horizon * side * side],
-            free: None,
+            open: free.iter().all(|&f| f),
+            first,
+            steps,
+            succ_start,
+            succ,
         }
     }
 
-    /// TEMPORARY (speed 1).
-    pub fn with_motion(horizon: usize, _speed: usize, free: impl Fn(i32, i32) -> bool) -> Self {
-        let mut g = Self::new(horizon);
-        g.free = Some(
-            (0..g.side * g.side)
-                .map(|i| {
-                    let h = horizon as i32;
-                    free((i % g.side) as i32 - h, (i / g.side) as i32 - h)
-                })
-                .collect(),
-        );
-        g
+    /// The tables with every cell free, cached per thread.
+    fn open(speed: usize, horizon: usize) -> Arc<Self> {
+        thread_local! {
+            static OPEN: RefCell<Vec<Arc<Motion>>> = const { RefCell::new(Vec::new()) };
+        }
+        OPEN.with_borrow_mut(|cache| {
+            if let Some(m) = cache
+                .iter()
+                .find(|m| m.speed == speed && m.horizon == horizon)
+            {
+                return Arc::clone(m);
+            }
+            let side = 2 * speed * horizon + 1;
+            let m = Arc::new(Self::build(speed, horizon, &vec![true; side * side]));
+            cache.push(Arc::clone(&m));
+            m
+        })
     }
 
-    /// TEMPORARY.
-    pub fn fill_step(&mut self, t: usize, mut f: impl FnMut(i32, i32) -> f64) {
-        let ti = t as i32;
-        for dr in -ti..=ti {
-            for dc in -ti..=ti {
-                let ok = self.free.as_ref().is_none_or(|fr| {
-                    fr[((dr + self.horizon as i32) as usize) * self.side
-                        + (dc + self.horizon as i32) as usize]
-                });
-                if ok {
-                    let v = f(dc, dr);
-                    self.set(t, dc, dr, v);
-                }
+    /// `m·T`: the largest `|dc|` or `|dr|` of an offset.
+    fn extent(&self) -> i32 {
+        (self.speed * self.horizon) as i32
+    }
+
+    /// The index of offset `(dc, dr)`, if inside the `side × side` square.
+    fn index(&self, dc: i32, dr: i32) -> Option<usize> {
+        let e = self.extent();
+        (dc.abs() <= e && dr.abs() <= e).then(|| (dr + e) as usize * self.side + (dc + e) as usize)
+    }
+
+    fn start(&self) -> usize {
+        let e = self.speed * self.horizon;
+        e * self.side + e
+    }
+
+    fn successors(&self, o: usize) -> &[u32] {
+        &self.succ[self.succ_start[o] as usize..self.succ_start[o + 1] as usize]
+    }
+
+    /// The offset one step `(dc, dr)` from `o` (reachable before step T), if
+    /// that step is legal.
+    fn step(&self, o: usize, (dc, dr): (i32, i32)) -> Option<usize> {
+        let m = self.speed as i32;
+        if dc.abs() > m || dr.abs() > m {
+            return None;
+        }
+        let w = 2 * m + 1;
+        let bit = ((dr + m) * w + dc + m) as u32;
+        (self.steps[o] >> bit & 1 == 1).then(|| (o as i32 + dr * self.side as i32 + dc) as usize)
+    }
+}
+
+/// Values of the cells a sensor can occupy, by step and offset from its
+/// start, together with its motion model (speed and free cells; see the
+/// module docs). A missing value (`None`) marks a cell the sensor may not
+/// end a step on.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ValueGrid {
+    motion: Arc<Motion>,
+    /// `values[(t−1)·side² + index]`.
+    values: Vec<Option<f64>>,
+}
+
+impl ValueGrid {
+    /// An empty grid (every value missing) for horizon `horizon ≥ 1`, speed
+    /// 1 and every offset free: the paper's model.
+    pub fn new(horizon: usize) -> Self {
+        Self::from_motion(Motion::open(1, horizon))
+    }
+
+    /// An empty grid for horizon `horizon`, speed `speed` (king moves per
+    /// step, `1..=MAX_SPEED`) and the free cells given by `free(dc, dr)`:
+    /// whether the cell at offset `(dc, dr)` from the start is on the lattice
+    /// and unblocked. `free` is called only for `|dc|, |dr| ≤ speed·horizon`
+    /// (at most once per offset); the start `(0, 0)` is always free.
+    ///
+    /// ```
+    /// use vigil::search::{ValueGrid, best_path};
+    /// // Speed 2, one step; a wall at dc = 1 (|dr| ≤ 1) hides the sensor's
+    /// // best cell (2, 0): it cannot jump over the wall in one step.
+    /// let wall = |dc: i32, dr: i32| !(dc == 1 && dr.abs() <= 1);
+    /// let mut grid = ValueGrid::with_motion(1, 2, wall);
+    /// assert_eq!(grid.side(), 5);
+    /// assert!(!grid.reachable(1, 2, 0) && !grid.reachable(1, 1, 0));
+    /// assert!(grid.reachable(1, 1, -2)); // past the wall's end
+    /// let cells: Vec<(i32, i32)> = {
+    ///     let mut v = Vec::new();
+    ///     grid.for_each_reachable(1, |dc, dr| v.push((dc, dr)));
+    ///     v
+    /// };
+    /// for (dc, dr) in cells {
+    ///     grid.set(1, dc, dr, f64::from(dc));
+    /// }
+    /// let best = best_path(&grid);
+    /// assert_eq!(best.moves, vec![(1, -2)]);
+    /// assert_eq!(best.value, 1.0);
+    /// ```
+    ///
+    /// # Panics
+    ///
+    /// If `speed` is not in `1..=MAX_SPEED`.
+    pub fn with_motion(horizon: usize, speed: usize, free: impl Fn(i32, i32) -> bool) -> Self {
+        assert!(
+            (1..=MAX_SPEED).contains(&speed),
+            "speed {speed} is not in 1..={MAX_SPEED}"
+        );
+        let e = (speed * horizon) as i32;
+        let side = 2 * speed * horizon + 1;
+        let mut mask = Vec::with_capacity(side * side);
+        let mut all = true;
+        for dr in -e..=e {
+            for dc in -e..=e {
+                let f = (dc == 0 && dr == 0) || free(dc, dr);
+                all &= f;
+                mask.push(f);
             }
+        }
+        let motion = if all {
+            Motion::open(speed, horizon)
+        } else {
+            Arc::new(Motion::build(speed, horizon, &mask))
+        };
+        Self::from_motion(motion)
+    }
+
+    fn from_motion(motion: Arc<Motion>) -> Self {
+        let len = motion.horizon * motion.side * motion.side;
+        Self {
+            motion,
+            values: vec![None; len],
         }
     }
 
     /// The horizon T.
     pub fn horizon(&self) -> usize {
-        self.horizon
+        self.motion.horizon
+    }
+
+    /// The speed m: king moves per step.
+    pub fn speed(&self) -> usize {
+        self.motion.speed
+    }
+
+    /// The side `2·m·T + 1` of the square of offsets, and of each step of
+    /// [`ValueGrid::to_nested`].
+    pub fn side(&self) -> usize {
+        self.motion.side
+    }
+
+    /// Whether offset `(dc, dr)` is reachable at step `t` (`1..=T`; step 0
+    /// is the start alone): `t` legal steps through free cells lead there.
+    pub fn reachable(&self, t: usize, dc: i32, dr: i32) -> bool {
+        t <= self.horizon()
+            && self
+                .motion
+                .index(dc, dr)
+                .is_some_and(|i| self.motion.first[i] <= t as u32)
+    }
+
+    /// Calls `f(dc, dr)` for every offset reachable at step `t`, in
+    /// row-major order (`dr` ascending, then `dc` ascending).
+    pub fn for_each_reachable(&self, t: usize, mut f: impl FnMut(i32, i32)) {
+        if t > self.horizon() {
+            return;
+        }
+        let mo = &*self.motion;
+        let (e, k) = (mo.extent(), (mo.speed * t) as i32);
+        for dr in -k..=k {
+            let row = (dr + e) as usize * mo.side;
+            for dc in -k..=k {
+                if mo.first[row + (dc + e) as usize] <= t as u32 {
+                    f(dc, dr);
+                }
+            }
+        }
+    }
+
+    /// Sets the value of every offset reachable at step `t` to `f(dc, dr)`,
+    /// visiting them as [`ValueGrid::for_each_reachable`] does; `None`
+    /// leaves an offset unset (a cell the caller knows is off the lattice).
+    pub fn fill_step(&mut self, t: usize, mut f: impl FnMut(i32, i32) -> Option<f64>) {
+        if t == 0 || t > self.horizon() {
+            return;
+        }
+        let mo = Arc::clone(&self.motion);
+        let (e, k) = (mo.extent(), (mo.speed * t) as i32);
+        let base = (t - 1) * mo.side * mo.side;
+        for dr in -k..=k {
+            let row = (dr + e) as usize * mo.side;
+            for dc in -k..=k {
+                let i = row + (dc + e) as usize;
+                if mo.first[i] <= t as u32
+                    && let Some(v) = f(dc, dr)
+                {
+                    self.values[base + i] = Some(v);
+                }
+            }
+        }
     }
 
     fn slot(&self, t: usize, dc: i32, dr: i32) -> Option<usize> {
-        let h = self.horizon as i32;
-        if t == 0 || t > self.horizon || dc.abs() > t as i32 || dr.abs() > t as i32 {
+        if t == 0 || t > self.horizon() {
             return None;
         }
-        let (c, r) = ((dc + h) as usize, (dr + h) as usize);
-        Some(((t - 1) * self.side + r) * self.side + c)
+        let i = self.motion.index(dc, dr)?;
+        (self.motion.first[i] <= t as u32).then(|| (t - 1) * self.side() * self.side() + i)
     }
 
     /// Sets the value of offset `(dc, dr)` at step `t` (1-based). Offsets
-    /// farther than `t` from the start are unreachable and ignored.
+    /// not reachable at step `t` are ignored.
     pub fn set(&mut self, t: usize, dc: i32, dr: i32, v: f64) {
         if let Some(i) = self.slot(t, dc, dr) {
             self.values[i] = Some(v);
@@ -115,27 +466,33 @@ impl ValueGrid {
         self.slot(t, dc, dr).and_then(|i| self.values[i])
     }
 
-    /// `values[t−1][dr+T][dc+T]`, `None` where unreachable or off the lattice.
+    /// `values[t−1][dr+m·T][dc+m·T]`, `None` where unreachable, not free or
+    /// unset; each step is `side × side`.
     pub fn to_nested(&self) -> Vec<Vec<Vec<Option<f64>>>> {
-        let h = self.horizon as i32;
-        (1..=self.horizon)
+        let e = self.motion.extent();
+        (1..=self.horizon())
             .map(|t| {
-                (-h..=h)
-                    .map(|dr| (-h..=h).map(|dc| self.get(t, dc, dr)).collect())
+                (-e..=e)
+                    .map(|dr| (-e..=e).map(|dc| self.get(t, dc, dr)).collect())
                     .collect()
             })
             .collect()
     }
 
-    /// Sum of the values along a move sequence, or `None` if it leaves the
-    /// set cells.
+    /// Sum of the values along a sequence of per-step displacements, or
+    /// `None` if a displacement is not a legal step from the current offset
+    /// (see the module docs), a value along the path is missing, or there
+    /// are more than T displacements.
     pub fn path_value(&self, moves: &[(i32, i32)]) -> Option<f64> {
-        let (mut c, mut r) = (0, 0);
+        if moves.len() > self.horizon() {
+            return None;
+        }
+        let n = self.side() * self.side();
+        let mut o = self.motion.start();
         let mut total = 0.0;
-        for (t, &(dc, dr)) in moves.iter().enumerate() {
-            c += dc;
-            r += dr;
-            total += self.get(t + 1, c, r)?;
+        for (t, &d) in moves.iter().enumerate() {
+            o = self.motion.step(o, d)?;
+            total += self.values[t * n + o]?;
         }
         Some(total)
     }
@@ -144,9 +501,9 @@ impl ValueGrid {
 /// An optimal path: the moves of steps 1..=T and their total value.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BestPath {
-    /// Move `(dc, dr)` taken at each step.
+    /// Displacement `(dc, dr)` taken at each step.
     pub moves: Vec<(i32, i32)>,
-    /// Sum of the grid values along the path.
+    /// Sum of the grid values along the path (`-∞` if there is no path).
     pub value: f64,
 }
 
@@ -165,89 +522,168 @@ impl BestPath {
     }
 }
 
-/// The optimal path by dynamic programming (see the module docs).
+/// The optimal path by dynamic programming over the space-time lattice (see
+/// the module docs), with the tie-breaking of [`brute_force`].
 ///
-/// The start itself must be on the lattice; cells with no value are never
-/// entered. Staying put is always possible, so a path exists whenever the
-/// start's own cell has values at every step.
+/// Cells with no value are never entered (they may be passed through within
+/// a step if free). Staying put is always legal, so a path exists whenever
+/// the start's own cell has values at every step. With no path at all, the
+/// moves are all `(0, 0)` and the value is `-∞`.
 pub fn best_path(grid: &ValueGrid) -> BestPath {
-    let h = grid.horizon as i32;
-    let side = grid.side;
-    let idx = |dc: i32, dr: i32| ((dr + h) as usize) * side + (dc + h) as usize;
-    // best[t] for t = T..1; NEG_INFINITY where unreachable.
-    let mut best = vec![vec![f64::NEG_INFINITY; side * side]; grid.horizon + 1];
-    for t in (1..=grid.horizon).rev() {
-        let ti = t as i32;
-        for dr in -ti..=ti {
-            for dc in -ti..=ti {
-                let Some(v) = grid.get(t, dc, dr) else {
-                    continue;
-                };
-                let future = if t == grid.horizon {
-                    0.0
-                } else {
-                    MOVES
+    let mo = &*grid.motion;
+    let (h, side, speed) = (mo.horizon, mo.side, mo.speed);
+    let n = side * side;
+    let e = speed * h;
+    // best[(t−1)·n + o] for t = 1..=T; -∞ where there is no path from (o, t).
+    let mut best = vec![f64::NEG_INFINITY; h * n];
+    let mut rowmax = if mo.open && h > 1 {
+        vec![f64::NEG_INFINITY; n]
+    } else {
+        Vec::new()
+    };
+    for t in (1..=h).rev() {
+        let (done, later) = best.split_at_mut(t * n);
+        let cur = &mut done[(t - 1) * n..];
+        let vals = &grid.values[(t - 1) * n..t * n];
+        let k = speed * t;
+        let rows = e - k..=e + k;
+        let cols = move |r: usize| r * side + e - k..=r * side + e + k;
+        if t == h {
+            for r in rows {
+                for o in cols(r) {
+                    if let Some(v) = vals[o] {
+                        cur[o] = v;
+                    }
+                }
+            }
+            continue;
+        }
+        let next = &later[..n];
+        if mo.open {
+            let layer = match speed {
+                1 => open_layer::<1>,
+                2 => open_layer::<2>,
+                _ => open_layer::<3>,
+            };
+            layer(side, e - k, e + k, vals, next, &mut rowmax, cur);
+        } else {
+            for r in rows {
+                for o in cols(r) {
+                    let Some(v) = vals[o] else { continue };
+                    cur[o] = v + mo
+                        .successors(o)
                         .iter()
-                        .filter_map(|&(mc, mr)| {
-                            let (c, r) = (dc + mc, dr + mr);
-                            (c.abs() <= ti + 1 && r.abs() <= ti + 1).then(|| best[t + 1][idx(c, r)])
-                        })
-                        .fold(f64::NEG_INFINITY, f64::max)
-                };
-                best[t][idx(dc, dr)] = v + future;
+                        .fold(f64::NEG_INFINITY, |a, &s| a.max(next[s as usize]));
+                }
             }
         }
     }
-    let (mut c, mut r) = (0, 0);
-    let mut moves = Vec::with_capacity(grid.horizon);
-    for (t, best_t) in best.iter().enumerate().skip(1) {
-        let mut choice = (0, 0);
+    let mut o = mo.start();
+    let mut moves = Vec::with_capacity(h);
+    let mut value = Some(0.0);
+    for t in 1..=h {
+        let row = &best[(t - 1) * n..t * n];
+        let mut choice = o;
         let mut top = f64::NEG_INFINITY;
-        for &(mc, mr) in &MOVES {
-            let (nc, nr) = (c + mc, r + mr);
-            if nc.abs() > t as i32 || nr.abs() > t as i32 {
-                continue;
-            }
-            let b = best_t[idx(nc, nr)];
+        for &s in mo.successors(o) {
+            let b = row[s as usize];
             if b > top {
                 top = b;
-                choice = (mc, mr);
+                choice = s as usize;
             }
         }
-        c += choice.0;
-        r += choice.1;
-        moves.push(choice);
+        moves.push((
+            (choice % side) as i32 - (o % side) as i32,
+            (choice / side) as i32 - (o / side) as i32,
+        ));
+        o = choice;
+        value = value.zip(grid.values[(t - 1) * n + o]).map(|(a, v)| a + v);
     }
-    let value = grid.path_value(&moves).unwrap_or(f64::NEG_INFINITY);
-    BestPath { moves, value }
+    BestPath {
+        moves,
+        value: value.unwrap_or(f64::NEG_INFINITY),
+    }
 }
 
-/// Exhaustive enumeration of the `9^T` move sequences in [`MOVES`] order,
-/// keeping the first strictly better one: the paper's search, as a reference
-/// for tests and benches.
+/// One layer of [`best_path`]'s programme for an open motion of speed `M`
+/// (every offset free): `cur[o] = vals[o] + max of next over the (2M+1)²
+/// square around o` for `o` in the box `lo..=hi` × `lo..=hi` of step t. The
+/// successors are that whole square, so their maximum is separable: maxima
+/// along rows into `rowmax`, then along columns. `hi + M` is inside the
+/// square of offsets (t < T), and `f64::max` is associative and commutative
+/// up to the sign of zeros, so `best` compares exactly as the successor
+/// lists' fold would.
+fn open_layer<const M: usize>(
+    side: usize,
+    lo: usize,
+    hi: usize,
+    vals: &[Option<f64>],
+    next: &[f64],
+    rowmax: &mut [f64],
+    cur: &mut [f64],
+) {
+    for r in lo - M..=hi + M {
+        let row = r * side;
+        let src = &next[row + lo - M..=row + hi + M];
+        for (dst, w) in rowmax[row + lo..=row + hi]
+            .iter_mut()
+            .zip(src.windows(2 * M + 1))
+        {
+            *dst = w.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b));
+        }
+    }
+    for r in lo..=hi {
+        let row = r * side;
+        for o in row + lo..=row + hi {
+            let Some(v) = vals[o] else { continue };
+            let f = (0..=2 * M).fold(f64::NEG_INFINITY, |a, i| {
+                a.max(rowmax[o + i * side - M * side])
+            });
+            cur[o] = v + f;
+        }
+    }
+}
+
+/// Exhaustive enumeration of the displacement sequences in
+/// [`step_displacements`] order (legal ones only: an illegal prefix is not
+/// extended), keeping the first strictly better one: the paper's search, as
+/// a reference for tests and benches. Its cost grows as `(2m+1)^(2T)`.
 pub fn brute_force(grid: &ValueGrid) -> BestPath {
+    let h = grid.horizon();
     let mut best = BestPath {
-        moves: vec![(0, 0); grid.horizon],
+        moves: vec![(0, 0); h],
         value: f64::NEG_INFINITY,
     };
-    let mut moves = Vec::with_capacity(grid.horizon);
-    fn go(grid: &ValueGrid, moves: &mut Vec<(i32, i32)>, best: &mut BestPath) {
-        if moves.len() == grid.horizon {
-            if let Some(v) = grid.path_value(moves)
-                && v > best.value
-            {
-                best.value = v;
+    let mut moves = Vec::with_capacity(h);
+    fn go(
+        grid: &ValueGrid,
+        o: usize,
+        total: f64,
+        moves: &mut Vec<(i32, i32)>,
+        best: &mut BestPath,
+    ) {
+        let t = moves.len();
+        if t == grid.horizon() {
+            if total > best.value {
+                best.value = total;
                 best.moves = moves.clone();
             }
             return;
         }
-        for &m in &MOVES {
-            moves.push(m);
-            go(grid, moves, best);
+        let n = grid.side() * grid.side();
+        for &d in step_displacements(grid.speed()) {
+            let Some(o2) = grid.motion.step(o, d) else {
+                continue;
+            };
+            let Some(v) = grid.values[t * n + o2] else {
+                continue;
+            };
+            moves.push(d);
+            go(grid, o2, total + v, moves, best);
             moves.pop();
         }
     }
-    go(grid, &mut moves, &mut best);
+    go(grid, grid.motion.start(), 0.0, &mut moves, &mut best);
     best
 }
 
@@ -255,6 +691,7 @@ pub fn brute_force(grid: &ValueGrid) -> BestPath {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+    use std::collections::{HashSet, VecDeque};
 
     fn grid_from(horizon: usize, vals: &[f64], holes: &[bool]) -> ValueGrid {
         let mut g = ValueGrid::new(horizon);
@@ -322,5 +759,285 @@ mod tests {
         let p = best_path(&g);
         assert_eq!(p.offsets(), vec![(1, 1), (2, 2), (3, 3)]);
         assert_eq!(p.value, 12.0);
+    }
+
+    /// A free mask over the offsets of (speed, horizon): `blocked[i]` below
+    /// `density` blocks the i-th offset in row-major order; the start is free.
+    fn mask(speed: usize, horizon: usize, cells: &[u8], density: u8) -> impl Fn(i32, i32) -> bool {
+        let e = (speed * horizon) as i32;
+        let side = 2 * e + 1;
+        let blocked: Vec<bool> = (0..side * side)
+            .map(|i| cells[i as usize % cells.len()] < density)
+            .collect();
+        move |dc: i32, dr: i32| {
+            assert!(
+                dc.abs() <= e && dr.abs() <= e,
+                "free({dc}, {dr}) outside the square"
+            );
+            (dc == 0 && dr == 0) || !blocked[((dr + e) * side + dc + e) as usize]
+        }
+    }
+
+    /// Independent reference: the offsets within `speed` king moves of
+    /// `from` through free cells (inside the square of extent `e`).
+    fn one_step(
+        free: &dyn Fn(i32, i32) -> bool,
+        e: i32,
+        from: (i32, i32),
+        speed: usize,
+    ) -> HashSet<(i32, i32)> {
+        let ok = |c: i32, r: i32| c.abs() <= e && r.abs() <= e && free(c, r);
+        let mut dist = std::collections::HashMap::new();
+        dist.insert(from, 0usize);
+        let mut queue = VecDeque::from([from]);
+        while let Some((c, r)) = queue.pop_front() {
+            let d = dist[&(c, r)];
+            if d == speed {
+                continue;
+            }
+            for dr in -1..=1 {
+                for dc in -1..=1 {
+                    let p = (c + dc, r + dr);
+                    if ok(p.0, p.1) && !dist.contains_key(&p) {
+                        dist.insert(p, d + 1);
+                        queue.push_back(p);
+                    }
+                }
+            }
+        }
+        dist.into_keys().collect()
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(96))]
+
+        #[test]
+        fn dp_equals_brute_force_with_speeds_and_blocks(
+            speed in 1usize..=3,
+            horizon in 1usize..=3,
+            cells in prop::collection::vec(0u8..10, 1..400),
+            density in 0u8..7,
+            vals in prop::collection::vec(0u8..4, 1..200),
+            holes in prop::collection::vec(prop::bool::weighted(0.1), 1..60),
+        ) {
+            let free = mask(speed, horizon, &cells, density);
+            let e = (speed * horizon) as i32;
+            let mut g = ValueGrid::with_motion(horizon, speed, &free);
+            prop_assert_eq!(g.side(), 2 * e as usize + 1);
+            prop_assert_eq!((g.speed(), g.horizon()), (speed, horizon));
+            // Reachability against an independent breadth-first search, and
+            // the visiting order of for_each_reachable.
+            let mut layer: HashSet<(i32, i32)> = HashSet::from([(0, 0)]);
+            let mut i = 0;
+            for t in 1..=horizon {
+                layer = layer.iter().flat_map(|&p| one_step(&free, e, p, speed)).collect();
+                let mut seen = Vec::new();
+                g.for_each_reachable(t, |dc, dr| seen.push((dc, dr)));
+                let mut expected: Vec<(i32, i32)> = layer.iter().copied().collect();
+                expected.sort_by_key(|&(c, r)| (r, c));
+                prop_assert_eq!(&seen, &expected);
+                for dr in -e - 1..=e + 1 {
+                    for dc in -e - 1..=e + 1 {
+                        prop_assert_eq!(g.reachable(t, dc, dr), layer.contains(&(dc, dr)));
+                    }
+                }
+                for (dc, dr) in seen {
+                    if !holes[i % holes.len()] {
+                        g.set(t, dc, dr, f64::from(vals[i % vals.len()]));
+                    }
+                    i += 1;
+                }
+            }
+            let dp = best_path(&g);
+            let bf = brute_force(&g);
+            prop_assert_eq!(dp.value, bf.value);
+            prop_assert_eq!(&dp.moves, &bf.moves);
+            prop_assert_eq!(dp.moves.len(), horizon);
+            if dp.value > f64::NEG_INFINITY {
+                prop_assert_eq!(g.path_value(&dp.moves), Some(dp.value));
+                let mut at = (0, 0);
+                for (&(dc, dr), &p) in dp.moves.iter().zip(&dp.offsets()) {
+                    prop_assert!(dc.abs().max(dr.abs()) <= speed as i32);
+                    prop_assert!(free(p.0, p.1), "stands on blocked {:?}", p);
+                    prop_assert!(one_step(&free, e, at, speed).contains(&p), "{:?} -> {:?}", at, p);
+                    at = p;
+                }
+            } else {
+                prop_assert_eq!(dp.moves, vec![(0, 0); horizon]);
+            }
+        }
+    }
+
+    #[test]
+    fn step_displacements_are_rings_then_rows() {
+        assert_eq!(step_displacements(1), &MOVES);
+        for m in 1..=MAX_SPEED {
+            let d = step_displacements(m);
+            let mi = m as i32;
+            assert_eq!(d.len(), (2 * m + 1) * (2 * m + 1));
+            assert_eq!(d[0], (0, 0));
+            let keys: Vec<_> = d
+                .iter()
+                .map(|&(c, r)| (c.abs().max(r.abs()), r, c))
+                .collect();
+            assert!(keys.windows(2).all(|w| w[0] < w[1]));
+            assert!(d.iter().all(|&(c, r)| c.abs() <= mi && r.abs() <= mi));
+        }
+    }
+
+    #[test]
+    fn new_is_speed_one_all_free() {
+        for h in 0..=4 {
+            assert_eq!(ValueGrid::new(h), ValueGrid::with_motion(h, 1, |_, _| true));
+        }
+        let g = ValueGrid::new(0);
+        assert_eq!(
+            best_path(&g),
+            BestPath {
+                moves: vec![],
+                value: 0.0
+            }
+        );
+    }
+
+    #[test]
+    fn illegal_steps_have_no_value() {
+        let mut g = ValueGrid::new(2);
+        for t in 1..=2 {
+            for dr in -2..=2 {
+                for dc in -2..=2 {
+                    g.set(t, dc, dr, 1.0);
+                }
+            }
+        }
+        assert_eq!(g.get(1, 2, 0), None);
+        assert_eq!(g.path_value(&[(1, 0), (1, 0)]), Some(2.0));
+        assert_eq!(g.path_value(&[(1, 0), (-2, 0)]), None);
+        assert_eq!(g.path_value(&[(2, 0)]), None);
+        assert_eq!(g.path_value(&[(0, 0); 3]), None);
+    }
+
+    /// Speed 2, T = 2, cells east of dc = 1 worth 100, the rest 1.
+    fn eastern_prize(free: impl Fn(i32, i32) -> bool) -> ValueGrid {
+        let mut g = ValueGrid::with_motion(2, 2, free);
+        for t in 1..=2 {
+            let mut cells = Vec::new();
+            g.for_each_reachable(t, |dc, dr| cells.push((dc, dr)));
+            for (dc, dr) in cells {
+                g.set(t, dc, dr, if dc >= 2 { 100.0 } else { 1.0 });
+            }
+        }
+        g
+    }
+
+    #[test]
+    fn speed_two_cannot_jump_a_wall() {
+        let open = eastern_prize(|_, _| true);
+        let p = best_path(&open);
+        assert_eq!(p.moves, vec![(2, -2), (0, 0)]);
+        assert_eq!(p.value, 200.0);
+        // A wall along the whole column dc = 1: nothing east is reachable.
+        let g = eastern_prize(|dc, _| dc != 1);
+        for t in 1..=2 {
+            for dr in -4..=4 {
+                for dc in 1..=4 {
+                    assert!(!g.reachable(t, dc, dr));
+                }
+            }
+        }
+        let p = best_path(&g);
+        assert_eq!(p, brute_force(&g));
+        assert_eq!(p.moves, vec![(0, 0), (0, 0)]);
+        assert_eq!(p.value, 2.0);
+        // A short wall (|dr| ≤ 1): around it in two steps, not in one.
+        let g = eastern_prize(|dc, dr| !(dc == 1 && dr.abs() <= 1));
+        assert!(!g.reachable(1, 2, 0) && g.reachable(2, 2, 0));
+        assert!(!g.reachable(1, 2, -2) && g.reachable(1, 1, -2));
+        let p = best_path(&g);
+        assert_eq!(p, brute_force(&g));
+        // Step 1 to (0, -1), then past the wall's end via (1, -2).
+        assert_eq!(p.moves, vec![(0, -1), (2, -2)]);
+        assert_eq!(p.value, 101.0);
+        assert!(
+            p.offsets()
+                .iter()
+                .all(|&(dc, dr)| !(dc == 1 && dr.abs() <= 1))
+        );
+    }
+
+    #[test]
+    fn speed_two_goes_around_a_single_block() {
+        // (1, 0) blocked: (2, 0) is still one step away, via (1, ±1).
+        let mut g = ValueGrid::with_motion(1, 2, |dc, dr| (dc, dr) != (1, 0));
+        assert!(!g.reachable(1, 1, 0));
+        assert!(g.reachable(1, 2, 0));
+        g.set(1, 0, 0, 1.0);
+        g.set(1, 1, 0, 9.0); // blocked: ignored
+        g.set(1, 2, 0, 5.0);
+        assert_eq!(g.get(1, 1, 0), None);
+        let p = best_path(&g);
+        assert_eq!(p.moves, vec![(2, 0)]);
+        assert_eq!(p.value, 5.0);
+        // Surrounded: the only legal step is to stay.
+        let mut g = ValueGrid::with_motion(1, 2, |dc, dr| dc == 0 && dr == 0);
+        for dr in -2..=2 {
+            for dc in -2..=2 {
+                g.set(1, dc, dr, 3.0);
+            }
+        }
+        assert_eq!(
+            best_path(&g),
+            BestPath {
+                moves: vec![(0, 0)],
+                value: 3.0
+            }
+        );
+        assert_eq!(g.path_value(&[(1, 0)]), None);
+    }
+
+    #[test]
+    fn unset_free_cells_are_passed_through_but_not_entered() {
+        // (1, 0) free without a value: a stepping stone to (2, 0).
+        let wall = |dc: i32, dr: i32| !(dc == 1 && dr != 0);
+        let mut g = ValueGrid::with_motion(1, 2, wall);
+        g.set(1, 0, 0, 0.0);
+        g.set(1, 2, 0, 4.0);
+        assert_eq!(best_path(&g).moves, vec![(2, 0)]);
+        assert_eq!(g.path_value(&[(1, 0)]), None);
+    }
+
+    #[test]
+    fn to_nested_is_side_squared_with_nulls() {
+        let blocked = [(1, 0), (-1, -1)];
+        let mut g = ValueGrid::with_motion(2, 2, |dc, dr| !blocked.contains(&(dc, dr)));
+        assert_eq!(g.side(), 9);
+        for t in 1..=2 {
+            for dr in -4..=4 {
+                for dc in -4..=4 {
+                    g.set(t, dc, dr, f64::from(dc * 10 + dr));
+                }
+            }
+        }
+        let nested = g.to_nested();
+        assert_eq!(nested.len(), 2);
+        for (t, step) in nested.iter().enumerate() {
+            let t = t + 1;
+            assert_eq!(step.len(), 9);
+            for (r, row) in step.iter().enumerate() {
+                assert_eq!(row.len(), 9);
+                for (c, v) in row.iter().enumerate() {
+                    let (dc, dr) = (c as i32 - 4, r as i32 - 4);
+                    let expect = (g.reachable(t, dc, dr)).then(|| f64::from(dc * 10 + dr));
+                    assert_eq!(*v, expect, "t={t} ({dc}, {dr})");
+                    if blocked.contains(&(dc, dr)) || dc.abs().max(dr.abs()) > 2 * t as i32 {
+                        assert_eq!(*v, None);
+                    }
+                }
+            }
+        }
+        // Speed 2 reaches ring 2 at step 1 and everything free at step 2.
+        assert!(nested[0][4 + 2][4 - 2].is_some());
+        assert!(nested[0][4][4 + 3].is_none());
+        assert!(nested[1][4 + 4][4 + 4].is_some());
     }
 }

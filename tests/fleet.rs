@@ -281,7 +281,7 @@ fn treating_uncertain_looks_as_certain_is_detected_as_biased() {
             .map(|(c, r)| cell(c, r))
             .to_vec()
     };
-    let probes = vec![
+    let probes = [
         Probe {
             sensor: 0,
             cell: cell(9, 9),

@@ -62,7 +62,9 @@ pub trait Estimator: Sync {
                 col: start.col + dc,
                 row: start.row + dr,
             };
-            self.value(sensor, k, t, excluded)
+            self.scenario()
+                .on_lattice(k)
+                .then(|| self.value(sensor, k, t, excluded))
         });
     }
 

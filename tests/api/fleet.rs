@@ -114,7 +114,7 @@ async fn fleet_specs_register_plan_and_keep_old_ids() {
     // The blocked cell (4,4) is offset (+1, 0) from the drone's (3,4):
     // null at every step, as is anything off the lattice.
     for step in values {
-        let row = step[2 * 3 + 0].as_array().unwrap();
+        let row = step[3 * 2].as_array().unwrap(); // dr = 0: m·T = 6
         assert_eq!(row[2 * 3 + 1], Value::Null);
     }
     for plan in plan["plans"].as_array().unwrap() {

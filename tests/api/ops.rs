@@ -331,9 +331,13 @@ async fn scenarios_survive_kill_9_and_corrupt_files_are_skipped() {
         .json()
         .await
         .unwrap();
-    // The three built-ins and the surviving scenario; the corrupt files are
+    // The built-ins and the surviving scenario; the corrupt files are
     // skipped but left in place.
-    assert_eq!(list["scenarios"].as_array().unwrap().len(), 4, "{list}");
+    assert_eq!(
+        list["scenarios"].as_array().unwrap().len(),
+        vigil::scenario::BUILTIN_IDS.len() + 1,
+        "{list}"
+    );
     assert!(dir.join("notes.json").exists());
     drop(server);
     let _ = std::fs::remove_dir_all(&dir);

@@ -388,7 +388,7 @@ impl Estimator for ExactEstimator<'_> {
                     col: start.col + dc,
                     row: start.row + dr,
                 };
-                self.value(sensor, k, t, excluded)
+                s.on_lattice(k).then(|| self.value(sensor, k, t, excluded))
             });
             return;
         };
@@ -426,6 +426,9 @@ impl Estimator for ExactEstimator<'_> {
                 col: start.col + dc,
                 row: start.row + dr,
             };
+            if !s.on_lattice(k) {
+                return None;
+            }
             let unseen = sums.sum(grid.span(ty.fov_slot, k));
             let fk = s.fov_region_of(self.types[sensor], k);
             let known: f64 = moved
@@ -433,7 +436,7 @@ impl Estimator for ExactEstimator<'_> {
                 .filter(|(p, _)| fk.contains(*p))
                 .map(|&(_, miss)| miss)
                 .sum();
-            ty.p_detect * (known + unseen)
+            Some(ty.p_detect * (known + unseen))
         });
     }
 

@@ -63,7 +63,7 @@ impl RayHits {
                 }
             }
         }
-        pieces.sort_unstable_by(|x, y| x.0.cmp(&y.0));
+        pieces.sort_unstable_by_key(|x| x.0);
         let mut offsets = vec![0u32; n + 1];
         let mut hits: Vec<(f64, f64)> = Vec::new();
         let mut detected: Vec<f64> = Vec::new();
