@@ -80,8 +80,22 @@ pub fn coordinate(
     mode: Coordination,
 ) -> Coordinated {
     let n = starts.len();
+    // Each sensor's motion (its speed, the free cells around it), built
+    // once and shared by every search it runs.
+    let motions: Vec<ValueGrid> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let start = starts[i];
+            ValueGrid::with_motion(horizon, s.types[types[i]].speed, |dc, dr| {
+                s.is_free(Cell {
+                    col: start.col + dc,
+                    row: start.row + dr,
+                })
+            })
+        })
+        .collect();
     let plan_one = |i: usize, fill: &mut dyn FnMut(usize, &mut ValueGrid)| {
-        search(s, starts[i], s.types[types[i]].speed, horizon, fill)
+        search(&motions[i], starts[i], fill)
     };
     // Every sensor alone.
     let mut plans: Vec<SensorPlan> = (0..n)
@@ -266,19 +280,12 @@ fn path_moves(start: Cell, path: &[Cell]) -> Vec<(i32, i32)> {
 /// Fills a value grid step by step with `fill(t, grid)` and searches it,
 /// for a sensor of speed `speed` that may stand on the free cells only.
 fn search(
-    s: &Scenario,
+    motion: &ValueGrid,
     start: Cell,
-    speed: usize,
-    horizon: usize,
     fill: &mut dyn FnMut(usize, &mut ValueGrid),
 ) -> SensorPlan {
-    let mut grid = ValueGrid::with_motion(horizon, speed, |dc, dr| {
-        s.is_free(Cell {
-            col: start.col + dc,
-            row: start.row + dr,
-        })
-    });
-    for t in 1..=horizon {
+    let mut grid = motion.clone();
+    for t in 1..=grid.horizon() {
         fill(t, &mut grid);
     }
     let BestPath { moves, value } = best_path(&grid);

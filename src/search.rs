@@ -29,9 +29,11 @@
 //! `best[t][o] = v[t][o] + max over the legal one-step successors o' of o of
 //! best[t+1][o']`, then one forward pass picks the steps. The grid
 //! precomputes, once per horizon, speed and free mask, which offsets are
-//! reachable at each step and each offset's successor list (speed 1 with
-//! every cell free, the planner's case, is cached per thread, so building a
-//! grid costs one allocation).
+//! reachable at each step and each offset's successor list. When every
+//! offset is free (the planner's case), those tables are cached per thread,
+//! so building a grid costs one allocation, and the successors of an offset
+//! are a whole square, so the maximum is taken separably (rows, then
+//! columns) in `O(T·(2mT+1)²·(2m+1))`.
 //!
 //! # Tie-breaking
 //!

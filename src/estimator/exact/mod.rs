@@ -411,16 +411,21 @@ impl Estimator for ExactEstimator<'_> {
         );
         let sums = self.block_sums(grid, win, (lo, hi, blo, bhi), excluded);
         // Known targets at step t, each with the chance that every excluded
-        // look misses it.
+        // look misses it: those no look holds are counted (an integer count
+        // is the hot loop's cheapest form), the others summed by weight.
         let all: Vec<&Look> = excluded.iter().collect();
-        let moved: Vec<(Point, f64)> = self
-            .known
-            .iter()
-            .map(|tg| tg.at(t))
-            .filter(|&p| s.in_zone(p))
-            .map(|p| (p, miss_all(&all, p)))
-            .filter(|&(_, miss)| miss > 0.0)
-            .collect();
+        let mut clear: Vec<Point> = Vec::with_capacity(self.known.len());
+        let mut partial: Vec<(Point, f64)> = Vec::new();
+        for p in self.known.iter().map(|tg| tg.at(t)) {
+            if !s.in_zone(p) {
+                continue;
+            }
+            match miss_all(&all, p) {
+                1.0 => clear.push(p),
+                0.0 => {}
+                miss => partial.push((p, miss)),
+            }
+        }
         out.fill_step(t, |dc, dr| {
             let k = Cell {
                 col: start.col + dc,
@@ -431,11 +436,14 @@ impl Estimator for ExactEstimator<'_> {
             }
             let unseen = sums.sum(grid.span(ty.fov_slot, k));
             let fk = s.fov_region_of(self.types[sensor], k);
-            let known: f64 = moved
-                .iter()
-                .filter(|(p, _)| fk.contains(*p))
-                .map(|&(_, miss)| miss)
-                .sum();
+            let mut known = clear.iter().filter(|&&p| fk.contains(p)).count() as f64;
+            if !partial.is_empty() {
+                known += partial
+                    .iter()
+                    .filter(|(p, _)| fk.contains(*p))
+                    .map(|&(_, miss)| miss)
+                    .sum::<f64>();
+            }
             Some(ty.p_detect * (known + unseen))
         });
     }

@@ -10,7 +10,6 @@
 
 use super::rays::SourceRays;
 use super::{max, min};
-use crate::geometry::Region;
 use crate::scenario::{Look, all_certain};
 
 /// What the rays of one source saw: per ray, the union of the intervals
@@ -31,11 +30,7 @@ pub(super) struct RayHits {
 impl RayHits {
     pub(super) fn new(sr: &SourceRays, observed: &[Vec<Look>], speed: f64) -> Self {
         if observed.iter().all(|step| all_certain(step)) {
-            let regions: Vec<Vec<Region>> = observed
-                .iter()
-                .map(|step| step.iter().map(|l| l.region).collect())
-                .collect();
-            Self::union(sr, &regions, speed)
+            Self::union(sr, observed, speed)
         } else {
             Self::weighted(sr, observed, speed)
         }
@@ -134,7 +129,7 @@ impl RayHits {
     }
 
     /// Seen sets of certain looks: unions of intervals.
-    fn union(sr: &SourceRays, observed: &[Vec<Region>], speed: f64) -> Self {
+    fn union(sr: &SourceRays, observed: &[Vec<Look>], speed: f64) -> Self {
         let mut buf = Vec::new();
         let n = sr.dirs.len();
         let o = sr.source.pos;
@@ -151,7 +146,7 @@ impl RayHits {
             spans.clear();
             let (mut lo, mut hi) = (n, 0);
             for (s, regions) in observed.iter().enumerate() {
-                let Some(region) = regions.get(i) else {
+                let Some(region) = regions.get(i).map(|l| &l.region) else {
                     continue;
                 };
                 if let Some((a, b)) = sr.range(region, &mut buf) {
