@@ -1,10 +1,14 @@
 //! The simulated world and the step loop of one run.
 //!
-//! Each step: observe (the targets inside any sensor's field of view now) →
-//! ask the policy for moves → move every sensor at most one cell → advance
-//! the targets one step → count. The targets come from
+//! Each step: observe (the targets the sensors detected now) → ask the
+//! policy for moves → move every sensor within its speed through free cells
+//! → advance the targets one step → detect and count. The targets come from
 //! [`vigil::world::World`] driven by an RNG of their own, seeded from the
-//! run's seed, so every policy sees the same target stream for the same seed.
+//! run's seed, so every policy sees the same target stream for the same
+//! seed. A sensor detects a target inside its field of view with its type's
+//! `p_detect`; those Bernoulli draws come from a third stream of their own
+//! (and are skipped when `p_detect` is 1), so they never disturb the
+//! targets either.
 
 use std::collections::{HashMap, HashSet, VecDeque};
 
@@ -15,7 +19,7 @@ use vigil::scenario::{Cell, Scenario};
 use vigil::world::World;
 
 use crate::metrics::StepCount;
-use crate::policy::{Policy, local_force_move, random_move};
+use crate::policy::{Policy, legal_moves, local_force_move, random_move};
 
 /// Where the sensors start.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -33,19 +37,92 @@ pub fn default_warmup(s: &Scenario) -> usize {
 }
 
 /// Near-square grid positions for `n` sensors: `cols = ⌈√n⌉` columns and
-/// enough rows, each sensor at the centre of its share of the zone.
+/// enough rows, each sensor at the centre of its share of the zone, moved
+/// to the nearest free cell when that one is blocked ([`nearest_free`]).
 pub fn grid_starts(s: &Scenario, n: usize) -> Vec<Cell> {
     let cols = (n as f64).sqrt().ceil().max(1.0) as usize;
     let rows = n.div_ceil(cols);
     (0..n)
         .map(|i| {
             let (c, r) = (i % cols, i / cols);
-            s.snap(Point::new(
-                (c as f64 + 0.5) * s.width / cols as f64,
-                (r as f64 + 0.5) * s.height / rows as f64,
-            ))
+            nearest_free(
+                s,
+                s.snap(Point::new(
+                    (c as f64 + 0.5) * s.width / cols as f64,
+                    (r as f64 + 0.5) * s.height / rows as f64,
+                )),
+            )
         })
         .collect()
+}
+
+/// `c` if it is free, else the first free cell on the nearest Chebyshev
+/// ring around it, rings scanned in the planner's tie order (by row, then
+/// column, from the south-west). `c` itself when no cell is free.
+pub fn nearest_free(s: &Scenario, c: Cell) -> Cell {
+    if s.is_free(c) {
+        return c;
+    }
+    for k in 1..s.cols.max(s.rows) {
+        for dr in -k..=k {
+            for dc in -k..=k {
+                if dc.abs().max(dr.abs()) != k {
+                    continue;
+                }
+                let n = Cell {
+                    col: c.col + dc,
+                    row: c.row + dr,
+                };
+                if s.is_free(n) {
+                    return n;
+                }
+            }
+        }
+    }
+    c
+}
+
+/// Sensor types for `n` sensors from a fleet such as `drone:4,robot:6`
+/// (the counts must add up to `n`): the first four `drone`, the next six
+/// `robot`. `None` gives every sensor the type `default`.
+pub fn fleet_types(s: &Scenario, fleet: Option<&str>, n: usize) -> Result<Vec<usize>, String> {
+    let Some(fleet) = fleet else {
+        return Ok(vec![0; n]);
+    };
+    let mut types = Vec::with_capacity(n);
+    for part in fleet.split(',') {
+        let (name, count) = part
+            .split_once(':')
+            .ok_or_else(|| format!("fleet entry {part:?} is not NAME:COUNT"))?;
+        let ty = s.type_index(name.trim()).ok_or_else(|| {
+            let known: Vec<&str> = s.types.iter().map(|t| t.name.as_str()).collect();
+            format!(
+                "the scenario has no sensor type {:?} (it has {})",
+                name.trim(),
+                known.join(", ")
+            )
+        })?;
+        let count: usize = count
+            .trim()
+            .parse()
+            .map_err(|_| format!("fleet entry {part:?}: {count:?} is not a count"))?;
+        types.extend(std::iter::repeat_n(ty, count));
+    }
+    if types.len() != n {
+        return Err(format!(
+            "the fleet {fleet:?} has {} sensors, the run {n}",
+            types.len()
+        ));
+    }
+    Ok(types)
+}
+
+/// The number of sensors of a fleet such as `drone:4,robot:6`, if it parses.
+pub fn fleet_size(fleet: &str) -> Option<usize> {
+    fleet
+        .split(',')
+        .map(|part| part.split_once(':')?.1.trim().parse::<usize>().ok())
+        .sum()
 }
 
 /// What the sensors know of a target in the zone.
@@ -71,8 +148,13 @@ pub struct Sim {
     pub world: World,
     world_rng: StdRng,
     sensor_rng: StdRng,
+    detect_rng: StdRng,
     /// Sensors' cells now.
     pub sensors: Vec<Cell>,
+    /// Sensors' types (indices into the scenario's `types`).
+    pub types: Vec<usize>,
+    /// The targets in the zone now, with how many sensors detected each.
+    now: Vec<(u64, Point, usize)>,
     /// Sensors' cells 1, 2, … steps ago (most recent first).
     pub history: VecDeque<Vec<Cell>>,
     history_len: usize,
@@ -91,9 +173,8 @@ pub struct Sim {
 }
 
 impl Sim {
-    /// A run: targets from `seed`, sensors placed by `start` (random starts
-    /// and the random policy use a separate RNG, so they never disturb the
-    /// target stream). `history_len` steps of history are kept.
+    /// A run of `sensors` sensors of the type `default`: see
+    /// [`Sim::with_types`].
     pub fn new(
         scenario: Scenario,
         sensors: usize,
@@ -101,21 +182,47 @@ impl Sim {
         seed: u64,
         history_len: usize,
     ) -> Self {
+        Self::with_types(scenario, vec![0; sensors], start, seed, history_len)
+    }
+
+    /// A run: targets from `seed`, one sensor per entry of `types` (its
+    /// type), placed by `start` on free cells (random starts and the random
+    /// policy use a separate RNG, so they never disturb the target stream).
+    /// `history_len` steps of history are kept.
+    pub fn with_types(
+        scenario: Scenario,
+        types: Vec<usize>,
+        start: Start,
+        seed: u64,
+        history_len: usize,
+    ) -> Self {
+        let sensors = types.len();
         let world_rng = StdRng::seed_from_u64(seed);
         let mut sensor_rng = StdRng::seed_from_u64(seed ^ 0x5e45_0125_u64.rotate_left(17));
+        let detect_rng = StdRng::seed_from_u64(seed ^ 0xde7e_c7ed_u64.rotate_left(29));
         let starts = match start {
             Start::Grid => grid_starts(&scenario, sensors),
             Start::Random => {
                 use rand::RngExt;
                 (0..sensors)
-                    .map(|_| Cell {
-                        col: sensor_rng.random_range(0..scenario.cols),
-                        row: sensor_rng.random_range(0..scenario.rows),
+                    .map(|_| {
+                        loop {
+                            let c = Cell {
+                                col: sensor_rng.random_range(0..scenario.cols),
+                                row: sensor_rng.random_range(0..scenario.rows),
+                            };
+                            if scenario.is_free(c) {
+                                break c;
+                            }
+                        }
                     })
                     .collect()
             }
         };
         Sim {
+            types,
+            detect_rng,
+            now: Vec::new(),
             world: World::empty(&scenario),
             scenario,
             world_rng,
@@ -152,23 +259,38 @@ impl Sim {
             / self.entered.len() as f64
     }
 
-    /// How many sensors see each target in the zone now, by target id.
-    fn detections(&self) -> Vec<(u64, Point, usize)> {
-        let fovs: Vec<_> = self
+    /// The targets in the zone now, each with its id, position and how many
+    /// sensors detected it this step (drawn once per step by `sense`).
+    pub fn detections(&self) -> Vec<(u64, Point, usize)> {
+        self.now.clone()
+    }
+
+    /// Draws this step's detections: each sensor detects each target inside
+    /// its field of view with its type's `p_detect` (no draw when it is 1).
+    fn sense(&mut self) {
+        let s = &self.scenario;
+        let looks: Vec<_> = self
             .sensors
             .iter()
-            .map(|&c| self.scenario.fov_region(c))
+            .zip(&self.types)
+            .map(|(&c, &ty)| s.look(ty, c))
             .collect();
-        self.world
-            .in_zone(&self.scenario)
+        let rng = &mut self.detect_rng;
+        self.now = self
+            .world
+            .in_zone(s)
             .map(|t| {
-                (
-                    t.id,
-                    t.pos,
-                    fovs.iter().filter(|r| r.contains(t.pos)).count(),
-                )
+                let n = looks
+                    .iter()
+                    .filter(|l| {
+                        use rand::RngExt;
+                        l.region.contains(t.pos)
+                            && (l.p_detect >= 1.0 || rng.random::<f64>() < l.p_detect)
+                    })
+                    .count();
+                (t.id, t.pos, n)
             })
-            .collect()
+            .collect();
     }
 
     /// Every target in the zone now, with its position and what the sensors
@@ -219,7 +341,7 @@ impl Sim {
                 id: Id::Number(i.into()),
                 x: centre(c).x,
                 y: centre(c).y,
-                sensor_type: None,
+                sensor_type: self.type_name(i),
             })
             .collect();
         let clairvoyant = policy == Policy::Clairvoyant;
@@ -247,7 +369,11 @@ impl Sim {
             .iter()
             .map(|step| {
                 step.iter()
-                    .map(|&c| PositionIn::at(centre(c).x, centre(c).y))
+                    .enumerate()
+                    .map(|(i, &c)| PositionIn {
+                        sensor_type: self.type_name(i),
+                        ..PositionIn::at(centre(c).x, centre(c).y)
+                    })
                     .collect()
             })
             .collect::<Vec<_>>();
@@ -263,6 +389,13 @@ impl Sim {
         }
     }
 
+    /// The name of sensor `i`'s type for a request; `None` for `default`
+    /// (requests then look as they did before sensor types existed).
+    fn type_name(&self, i: usize) -> Option<String> {
+        let ty = self.types[i];
+        (ty != 0).then(|| self.scenario.types[ty].name.clone())
+    }
+
     /// Next cells of a local policy.
     pub fn local_moves(&mut self, policy: Policy) -> Vec<Cell> {
         let s = &self.scenario;
@@ -271,7 +404,8 @@ impl Sim {
                 let rng = &mut self.sensor_rng;
                 self.sensors
                     .iter()
-                    .map(|&c| random_move(s, c, rng))
+                    .zip(&self.types)
+                    .map(|(&c, &ty)| random_move(s, c, s.types[ty].speed, rng))
                     .collect()
             }
             Policy::LocalForce => {
@@ -282,7 +416,7 @@ impl Sim {
                     .map(|d| d.1)
                     .collect();
                 (0..self.sensors.len())
-                    .map(|i| local_force_move(s, i, &self.sensors, &seen))
+                    .map(|i| local_force_move(s, i, &self.sensors, &self.types, &seen))
                     .collect()
             }
             _ => self.sensors.clone(),
@@ -290,7 +424,8 @@ impl Sim {
     }
 
     /// The first cell of each sensor's path in a plan, checked to be a legal
-    /// move (the planner's contract).
+    /// move for its type's speed through free cells (the planner's
+    /// contract).
     pub fn moves_from_plan(&self, plan: &PlanResponse) -> Result<Vec<Cell>, String> {
         if plan.plans.len() != self.sensors.len() {
             return Err(format!(
@@ -301,16 +436,15 @@ impl Sim {
         }
         plan.plans
             .iter()
-            .zip(&self.sensors)
-            .map(|(p, &c)| {
+            .zip(self.sensors.iter().zip(&self.types))
+            .map(|(p, (&c, &ty))| {
                 let first = p.path.first().ok_or("an empty path")?;
                 let next = Cell {
                     col: first.col,
                     row: first.row,
                 };
-                let legal = (next.col - c.col).abs() <= 1
-                    && (next.row - c.row).abs() <= 1
-                    && self.scenario.on_lattice(next);
+                let speed = self.scenario.types[ty].speed;
+                let legal = legal_moves(&self.scenario, c, speed).contains(&next);
                 legal
                     .then_some(next)
                     .ok_or_else(|| format!("illegal move {c:?} → {next:?}"))
@@ -328,6 +462,7 @@ impl Sim {
         }
         self.world.step(&self.scenario, &mut self.world_rng);
         self.step += 1;
+        self.sense();
         let detections = self.detections();
         let mut count = StepCount {
             in_zone: detections.len(),

@@ -10,7 +10,7 @@ use tokio::sync::Semaphore;
 use vigil::scenario::Scenario;
 
 use crate::client::{Client, ClientError};
-use crate::driver::{Sim, Start};
+use crate::driver::{Sim, Start, fleet_types};
 use crate::metrics::{Metrics, RunAccumulator, summarize};
 use crate::policy::{ALL_POLICIES, Policy};
 
@@ -27,6 +27,10 @@ pub struct RunConfig {
     pub scenario: Scenario,
     /// Number of sensors.
     pub sensors: usize,
+    /// Their types, as `NAME:COUNT,…` (e.g. `drone:4,robot:6`, adding up to
+    /// `sensors`, checked by [`fleet_types`] before runs start); `None`:
+    /// every sensor is `default`.
+    pub fleet: Option<String>,
     /// Measured steps.
     pub steps: usize,
     /// Steps before measuring (sensors observe but hold still).
@@ -44,9 +48,9 @@ impl RunConfig {
     /// stationary state while the sensors watched from their starting
     /// cells, building tracks and history; the measured window starts now.
     pub fn warmed_up(&self, seed: u64) -> Sim {
-        let mut sim = Sim::new(
+        let mut sim = Sim::with_types(
             self.scenario.clone(),
-            self.sensors,
+            self.types(),
             self.start,
             seed,
             self.history,
@@ -58,6 +62,15 @@ impl RunConfig {
         }
         sim.start_window();
         sim
+    }
+}
+
+impl RunConfig {
+    /// Each sensor's type. A fleet that does not fit the scenario (which
+    /// [`fleet_types`] reports before runs start) falls back to `default`.
+    pub fn types(&self) -> Vec<usize> {
+        fleet_types(&self.scenario, self.fleet.as_deref(), self.sensors)
+            .unwrap_or_else(|_| vec![0; self.sensors])
     }
 }
 
@@ -114,6 +127,8 @@ pub struct Row {
     pub scenario: String,
     /// Number of sensors.
     pub sensors: usize,
+    /// Their types (`drone:4,robot:6`), when given.
+    pub fleet: Option<String>,
     /// Target speed, when every target flies at one speed (null for a
     /// speed mixture).
     pub target_speed: Option<f64>,
@@ -182,6 +197,7 @@ pub async fn run_all(
                 policy: cfg.policy.name().to_owned(),
                 scenario: cfg.scenario_id.clone(),
                 sensors: cfg.sensors,
+                fleet: cfg.fleet.clone(),
                 target_speed: cfg.scenario.single_speed(),
                 steps: cfg.steps,
                 seeds: runs.len(),
@@ -205,17 +221,33 @@ pub const GRID: [(usize, &str); 4] = [
 /// cyclists and vehicles from directed gates) with 10 and 6 sensors.
 pub const MIXED_GRID: [(usize, &str); 2] = [(10, "site-gates"), (6, "site-gates")];
 
+/// The `fleet` experiment's grid: the built-in `site-fleet` (robots and
+/// drones around no-go zones) with ten sensors, in the fleets of
+/// [`FLEETS`].
+pub const FLEET_GRID: [(usize, &str); 3] =
+    [(10, "site-fleet"), (10, "site-fleet"), (10, "site-fleet")];
+
+/// The fleets of the `fleet` experiment's rows: ten robots, four drones
+/// and six robots, ten drones.
+pub const FLEETS: [&str; 3] = ["robot:10", "drone:4,robot:6", "drone:10"];
+
 /// The experiments, by name.
-pub const EXPERIMENTS: [&str; 3] = ["table1", "table2", "mixed"];
+pub const EXPERIMENTS: [&str; 4] = ["table1", "table2", "mixed", "fleet"];
 
 /// The grid of an experiment: [`GRID`] for the paper's tables,
-/// [`MIXED_GRID`] for `mixed`.
+/// [`MIXED_GRID`] for `mixed`, [`FLEET_GRID`] for `fleet`.
 pub fn experiment_grid(name: &str) -> Option<&'static [(usize, &'static str)]> {
     match name {
         "table1" | "table2" => Some(&GRID),
         "mixed" => Some(&MIXED_GRID),
+        "fleet" => Some(&FLEET_GRID),
         _ => None,
     }
+}
+
+/// The fleet of row `n` of an experiment's grid, if its sensors have types.
+pub fn experiment_fleet(name: &str, n: usize) -> Option<&'static str> {
+    (name == "fleet").then(|| FLEETS.get(n).copied()).flatten()
 }
 
 /// The policies of an experiment, with their row letters: Table 1 compares
@@ -227,7 +259,7 @@ pub fn experiment_policies(name: &str) -> Option<Vec<(char, Policy)>> {
             ('a', Policy::Paper),
             ('b', Policy::PaperUncoordinated),
         ]),
-        "table2" | "mixed" => Some(('a'..).zip(ALL_POLICIES).collect()),
+        "table2" | "mixed" | "fleet" => Some(('a'..).zip(ALL_POLICIES).collect()),
         _ => None,
     }
 }

@@ -319,7 +319,7 @@ struct Init {
     /// Row-major, index `row·cols + col`.
     d_hat: Vec<f64>,
     sources: Vec<SourceOut>,
-    /// Rectangles sensors may not enter: none in the model yet.
+    /// Rectangles sensors may not enter (the scenario's `no_go`).
     no_go: Vec<RectOut>,
 }
 
@@ -375,7 +375,18 @@ impl Init {
             fov: s.fov,
             d_hat: stats.d_hat.clone(),
             sources,
-            no_go: Vec::new(),
+            no_go: s
+                .spec
+                .no_go
+                .iter()
+                .flatten()
+                .map(|r| RectOut {
+                    x0: r.x0,
+                    y0: r.y0,
+                    x1: r.x1,
+                    y1: r.y1,
+                })
+                .collect(),
         }
     }
 }
@@ -404,6 +415,10 @@ struct Frame<'a> {
 struct SensorOut {
     col: i32,
     row: i32,
+    /// Its type's name and field of view.
+    #[serde(rename = "type")]
+    sensor_type: String,
+    fov: FovSpec,
     /// Rank in the last plan, 1 = highest.
     priority: Option<usize>,
     /// The last plan's path from the cell the sensor planned from:
@@ -491,6 +506,8 @@ fn publish(
             SensorOut {
                 col: c.col,
                 row: c.row,
+                sensor_type: sim.scenario.types[sim.types[i]].name.clone(),
+                fov: sim.scenario.types[sim.types[i]].fov,
                 priority: planned.map(|p| p.priority),
                 path: planned
                     .map(|p| {

@@ -5,6 +5,8 @@
 //! vigil-sim --experiment table1 --seeds 10          # the paper's Table 1
 //! vigil-sim --experiment table2                     # every policy
 //! vigil-sim --experiment mixed                      # every policy on site-gates
+//! vigil-sim --experiment fleet                      # every policy on site-fleet, three fleets
+//! vigil-sim --scenario site-fleet --fleet drone:4,robot:6 --svg fleet.svg
 //! vigil-sim --policy exact --sensors 10 --svg run.svg
 //! vigil-sim --live --policy exact --sensors 10      # watch one run in a browser
 //! ```
@@ -17,9 +19,10 @@ use std::process::ExitCode;
 use clap::Parser;
 use vigil::scenario::{Scenario, ScenarioSpec};
 use vigil_sim::client::{Client, spawn_local_server};
-use vigil_sim::driver::{Start, default_warmup};
+use vigil_sim::driver::{Start, default_warmup, fleet_size, fleet_types};
 use vigil_sim::experiment::{
-    EXPERIMENTS, RunConfig, experiment_grid, experiment_policies, run_all, run_one,
+    EXPERIMENTS, RunConfig, experiment_fleet, experiment_grid, experiment_policies, run_all,
+    run_one,
 };
 use vigil_sim::live::{Live, LiveOptions};
 use vigil_sim::policy::Policy;
@@ -34,7 +37,9 @@ use vigil_sim::{report, svg};
 struct Args {
     /// Run an experiment grid: `table1` (paper vs paper-uncoordinated) or
     /// `table2` (every policy) over NS ∈ {10, 6} × TV ∈ {10, 15}, or `mixed`
-    /// (every policy on `site-gates` with NS ∈ {10, 6}).
+    /// (every policy on `site-gates` with NS ∈ {10, 6}), or `fleet` (every
+    /// policy on `site-fleet` with ten robots, four drones and six robots,
+    /// ten drones).
     #[arg(long)]
     experiment: Option<String>,
     /// Policy of a single run.
@@ -43,6 +48,11 @@ struct Args {
     /// Number of sensors of a single run.
     #[arg(long, default_value_t = 10)]
     sensors: usize,
+    /// Sensor types of a single run, `NAME:COUNT,…` (e.g. `drone:4,robot:6`,
+    /// types of the scenario's `sensor_types`); sets the number of sensors.
+    /// By default every sensor is of the type `default`.
+    #[arg(long)]
+    fleet: Option<String>,
     /// Scenario of a single run: a server id, or a ScenarioSpec JSON file.
     #[arg(long, default_value = "paper-v10")]
     scenario: String,
@@ -128,19 +138,24 @@ async fn run(args: Args) -> Result<(), String> {
             .map_err(|e| format!("cannot start a server: {e}"))?,
     };
     let client = Client::new(&base);
-    let config =
-        |label: String, policy: Policy, id: String, scenario: Scenario, sensors: usize| RunConfig {
-            label,
-            policy,
-            warmup: args.warmup.unwrap_or_else(|| default_warmup(&scenario)),
-            scenario_id: id,
-            scenario,
-            sensors,
-            steps: args.steps,
-            horizon: args.horizon,
-            history: args.history.into(),
-            start: args.start,
-        };
+    let config = |label: String,
+                  policy: Policy,
+                  id: String,
+                  scenario: Scenario,
+                  sensors: usize,
+                  fleet: Option<&str>| RunConfig {
+        label,
+        policy,
+        warmup: args.warmup.unwrap_or_else(|| default_warmup(&scenario)),
+        scenario_id: id,
+        scenario,
+        sensors,
+        fleet: fleet.map(str::to_owned),
+        steps: args.steps,
+        horizon: args.horizon,
+        history: args.history.into(),
+        start: args.start,
+    };
     let configs = match &args.experiment {
         Some(name) => {
             let unknown = || format!("unknown experiment `{name}` ({})", EXPERIMENTS.join(", "));
@@ -156,6 +171,7 @@ async fn run(args: Args) -> Result<(), String> {
                         id.clone(),
                         scenario.clone(),
                         *sensors,
+                        experiment_fleet(name, n),
                     ));
                 }
             }
@@ -163,17 +179,27 @@ async fn run(args: Args) -> Result<(), String> {
         }
         None => {
             let (id, scenario) = resolve(&client, &args.scenario).await?;
+            let sensors = match &args.fleet {
+                Some(fleet) => fleet_size(fleet)
+                    .ok_or_else(|| format!("--fleet {fleet:?}: expected NAME:COUNT,…"))?,
+                None => args.sensors,
+            };
             vec![config(
                 args.policy.name().to_owned(),
                 args.policy,
                 id,
                 scenario,
-                args.sensors,
+                sensors,
+                args.fleet.as_deref(),
             )]
         }
     };
     if configs.iter().any(|c| c.sensors == 0) {
         return Err("--sensors must be at least 1".into());
+    }
+    for c in &configs {
+        fleet_types(&c.scenario, c.fleet.as_deref(), c.sensors)
+            .map_err(|e| format!("--fleet: {e}"))?;
     }
     if args.live {
         if args.experiment.is_some() {

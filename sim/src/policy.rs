@@ -8,7 +8,7 @@ use vigil::coordination::Coordination;
 use vigil::geometry::Point;
 use vigil::planner::{EstimatorKind, Observed};
 use vigil::scenario::{Cell, FovSpec, Scenario};
-use vigil::search::MOVES;
+use vigil::search::{MOVES, step_displacements};
 
 /// How the sensors move.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
@@ -98,21 +98,48 @@ impl fmt::Display for Policy {
     }
 }
 
-/// The legal moves from `c`: the nine of [`MOVES`] that stay on the lattice.
-pub fn legal_moves(s: &Scenario, c: Cell) -> Vec<Cell> {
-    MOVES
+/// The legal moves from `c` of a sensor of speed `speed`: the cells within
+/// `speed` king moves through free cells (on the lattice, not blocked), in
+/// the planner's tie order ([`step_displacements`]: stay first). At speed 1
+/// on an open lattice these are the nine of [`MOVES`] that stay on it.
+pub fn legal_moves(s: &Scenario, c: Cell, speed: usize) -> Vec<Cell> {
+    let m = speed as i32;
+    let w = (2 * m + 1) as usize;
+    let at = |dc: i32, dr: i32| ((dr + m) as usize) * w + (dc + m) as usize;
+    // Breadth-first search in the (2m+1)² window around c.
+    let mut reach = vec![false; w * w];
+    reach[at(0, 0)] = true;
+    let mut frontier = vec![(0, 0)];
+    for _ in 0..speed {
+        let mut next = Vec::new();
+        for &(c0, r0) in &frontier {
+            for &(dc, dr) in &MOVES[1..] {
+                let (nc, nr) = (c0 + dc, r0 + dr);
+                let cell = Cell {
+                    col: c.col + nc,
+                    row: c.row + nr,
+                };
+                if nc.abs() <= m && nr.abs() <= m && !reach[at(nc, nr)] && s.is_free(cell) {
+                    reach[at(nc, nr)] = true;
+                    next.push((nc, nr));
+                }
+            }
+        }
+        frontier = next;
+    }
+    step_displacements(speed)
         .iter()
+        .filter(|&&(dc, dr)| reach[at(dc, dr)])
         .map(|&(dc, dr)| Cell {
             col: c.col + dc,
             row: c.row + dr,
         })
-        .filter(|&n| s.on_lattice(n))
         .collect()
 }
 
-/// A uniform legal move.
-pub fn random_move(s: &Scenario, c: Cell, rng: &mut impl rand::Rng) -> Cell {
-    let moves = legal_moves(s, c);
+/// A uniform legal move of a sensor of speed `speed`.
+pub fn random_move(s: &Scenario, c: Cell, speed: usize, rng: &mut impl rand::Rng) -> Cell {
+    let moves = legal_moves(s, c, speed);
     moves[rng.random_range(0..moves.len())]
 }
 
@@ -137,17 +164,25 @@ pub mod force {
 ///   half widths, a unit vector away from it times
 ///   `REPULSION·(1 − d/range)` (so fields of view spread out).
 ///
-/// The sensor takes the legal move whose direction best aligns with the net
-/// force (the move maximising `force·move/|move|`), or stays when the force
+/// Each sensor reads its own type's field of view. The sensor takes the
+/// legal move (within its speed, through free cells) whose direction best
+/// aligns with the net force (the move maximising `force·move/|move|`), or stays when the force
 /// is below [`force::DEADBAND`] or no move points along it.
-pub fn local_force_move(s: &Scenario, me: usize, sensors: &[Cell], observed: &[Point]) -> Cell {
+pub fn local_force_move(
+    s: &Scenario,
+    me: usize,
+    sensors: &[Cell],
+    types: &[usize],
+    observed: &[Point],
+) -> Cell {
     let here = sensors[me];
     let p = s.centre(here);
-    let half = match s.fov {
+    let ty = &s.types[types[me]];
+    let half = match ty.fov {
         FovSpec::Square { half_width } => half_width,
         FovSpec::Circle { radius } => radius,
     };
-    let region = s.fov_region(here);
+    let region = s.fov_region_of(types[me], here);
     let (mut fx, mut fy) = (0.0, 0.0);
     for t in observed.iter().filter(|&&t| region.contains(t)) {
         let (dx, dy) = (t.x - p.x, t.y - p.y);
@@ -183,7 +218,7 @@ pub fn local_force_move(s: &Scenario, me: usize, sensors: &[Cell], observed: &[P
     }
     let mut best = here;
     let mut best_score = 0.0;
-    for n in legal_moves(s, here) {
+    for n in legal_moves(s, here, ty.speed) {
         let (dc, dr) = ((n.col - here.col) as f64, (n.row - here.row) as f64);
         let len = dc.hypot(dr);
         if len == 0.0 {

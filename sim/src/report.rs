@@ -18,7 +18,8 @@ fn opt(mean: Option<f64>, ci: Option<f64>, decimals: usize) -> String {
 }
 
 /// The rows as a table: the paper's columns (EN NS AD ZD AF D1S D2S D3S TV),
-/// then ours (policy, detected once, calibration, plan round trip p50/p99),
+/// then ours (policy, detected once, calibration, plan round trip p50/p99);
+/// NS shows the fleet (`drone:4,robot:6`) when the sensors have types,
 /// each mean ± the half-width of its 95% confidence interval over seeds.
 pub fn table(rows: &[Row]) -> String {
     let header = [
@@ -31,7 +32,7 @@ pub fn table(rows: &[Row]) -> String {
             let (m, c) = (&r.metrics, &r.ci95);
             [
                 r.label.clone(),
-                r.sensors.to_string(),
+                r.fleet.clone().unwrap_or_else(|| r.sensors.to_string()),
                 pm(m.ad, c.ad, 1),
                 pm(m.zd, c.zd, 1),
                 pm(m.af, c.af, 2),
@@ -69,7 +70,7 @@ pub fn table(rows: &[Row]) -> String {
     out
 }
 
-/// The JSON report: `{"runs":[{label, policy, scenario, sensors,
+/// The JSON report: `{"runs":[{label, policy, scenario, sensors, fleet,
 /// target_speed, steps, seeds, metrics, ci95}]}`.
 pub fn json(rows: &[Row]) -> serde_json::Result<String> {
     #[derive(Serialize)]

@@ -1,6 +1,8 @@
 //! A picture of one run, like the paper's Figure 3: the zone over a heat map
-//! of `d_hat`, the sources, every sensor's trace and final position with its
-//! field of view, and the targets at the last step.
+//! of `d_hat`, the no-go zones (grey, hatched), the sources, every sensor's
+//! trace and final position with its own type's field of view (one marker
+//! per type: a disk for `default`, then a square, a triangle, …, named in a
+//! legend), and the targets at the last step.
 
 use plotters::prelude::*;
 use vigil::stats::Stats;
@@ -39,6 +41,31 @@ pub fn draw(sim: &Sim, path: &std::path::Path) -> Result<(), String> {
         ))
         .map_err(err)?;
     }
+    let grey = RGBColor(150, 150, 150);
+    for r in s.spec.no_go.iter().flatten() {
+        let (x0, x1) = (r.x0.clamp(0.0, s.width), r.x1.clamp(0.0, s.width));
+        let (y0, y1) = (r.y0.clamp(0.0, s.height), r.y1.clamp(0.0, s.height));
+        if x1 <= x0 || y1 <= y0 {
+            continue;
+        }
+        root.draw(&Rectangle::new(
+            [px(x0, y1), px(x1, y0)],
+            RGBColor(215, 215, 215).filled(),
+        ))
+        .map_err(err)?;
+        // Hatching at 45°, every 8 px.
+        let (a, b) = (px(x0, y1), px(x1, y0));
+        let mut k = 0;
+        while k < (b.0 - a.0) + (b.1 - a.1) {
+            let start = (a.0 + k.min(b.0 - a.0), a.1 + (k - (b.0 - a.0)).max(0));
+            let end = (a.0 + (k - (b.1 - a.1)).max(0), a.1 + k.min(b.1 - a.1));
+            root.draw(&PathElement::new(vec![start, end], grey.stroke_width(1)))
+                .map_err(err)?;
+            k += 8;
+        }
+        root.draw(&Rectangle::new([a, b], grey.stroke_width(1)))
+            .map_err(err)?;
+    }
     root.draw(&Rectangle::new(
         [px(0.0, s.height), px(s.width, 0.0)],
         BLACK.stroke_width(2),
@@ -65,16 +92,63 @@ pub fn draw(sim: &Sim, path: &std::path::Path) -> Result<(), String> {
         root.draw(&PathElement::new(points, color.stroke_width(2)))
             .map_err(err)?;
         if let Some(&last) = trace.last() {
-            let r = s.fov_region(last).rect;
-            root.draw(&Rectangle::new(
-                [px(r.x0, r.y1), px(r.x1, r.y0)],
-                color.stroke_width(1),
-            ))
+            let ty = sim.types[i];
+            let region = s.fov_region_of(ty, last);
+            match region.disk {
+                Some(d) => root.draw(&Circle::new(
+                    px(d.c.x, d.c.y),
+                    (d.r * scale) as i32,
+                    color.stroke_width(1),
+                )),
+                None => root.draw(&Rectangle::new(
+                    [
+                        px(region.rect.x0, region.rect.y1),
+                        px(region.rect.x1, region.rect.y0),
+                    ],
+                    color.stroke_width(1),
+                )),
+            }
             .map_err(err)?;
             let p = s.centre(last);
-            root.draw(&Circle::new(px(p.x, p.y), 7, color.filled()))
-                .map_err(err)?;
+            marker(&root, ty, px(p.x, p.y), color.filled()).map_err(err)?;
+        }
+    }
+    // A legend of the types in the run.
+    let mut used: Vec<usize> = sim.types.clone();
+    used.sort_unstable();
+    used.dedup();
+    if used != [0] {
+        for (k, &ty) in used.iter().enumerate() {
+            let at = (40 + 200 * k as i32, 14);
+            marker(&root, ty, at, BLACK.filled()).map_err(err)?;
+            let t = &s.types[ty];
+            root.draw(&Text::new(
+                format!("{} (speed {}, p {})", t.name, t.speed, t.p_detect),
+                (at.0 + 10, at.1 - 6),
+                ("sans-serif", 12),
+            ))
+            .map_err(err)?;
         }
     }
     root.present().map_err(|e| e.to_string())
+}
+
+/// The marker of sensor type `ty` at pixel `at`: a disk, a square, a
+/// triangle, then a cross.
+fn marker<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    ty: usize,
+    at: (i32, i32),
+    style: ShapeStyle,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let (x, y) = at;
+    match ty % 4 {
+        0 => root.draw(&Circle::new(at, 7, style)),
+        1 => root.draw(&Rectangle::new([(x - 6, y - 6), (x + 6, y + 6)], style)),
+        2 => root.draw(&Polygon::new(
+            vec![(x, y - 8), (x - 7, y + 6), (x + 7, y + 6)],
+            style,
+        )),
+        _ => root.draw(&Cross::new(at, 7, style.stroke_width(3))),
+    }
 }

@@ -116,13 +116,14 @@ function drawStatic() {
   }
 }
 
-function fovPath(col, row) {
+function fovPath(col, row, fov) {
+  fov = fov || init.fov;
   const cx = (col + 0.5) * init.cell_size, cy = (row + 0.5) * init.cell_size;
   ctx.beginPath();
-  if (init.fov.shape === "circle") {
-    ctx.arc(px(cx), py(cy), init.fov.radius * scale, 0, 2 * Math.PI);
+  if (fov.shape === "circle") {
+    ctx.arc(px(cx), py(cy), fov.radius * scale, 0, 2 * Math.PI);
   } else {
-    const hw = init.fov.half_width;
+    const hw = fov.half_width;
     const x0 = Math.max(0, cx - hw), x1 = Math.min(init.width, cx + hw);
     const y0 = Math.max(0, cy - hw), y1 = Math.min(init.height, cy + hw);
     ctx.rect(px(x0), py(y1), (x1 - x0) * scale, (y1 - y0) * scale);
@@ -185,7 +186,7 @@ function draw() {
   });
   // Fields of view.
   f.sensors.forEach((s) => {
-    fovPath(s.col, s.row);
+    fovPath(s.col, s.row, s.fov);
     ctx.fillStyle = priorityColour(s.priority, 0.08);
     ctx.fill();
     ctx.strokeStyle = priorityColour(s.priority, 0.75);

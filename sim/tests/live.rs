@@ -112,6 +112,7 @@ async fn live_view_in_headless_chromium() {
         scenario_id: info.id,
         scenario,
         sensors: SENSORS,
+        fleet: None,
         steps: 400,
         warmup: 20,
         horizon: None,

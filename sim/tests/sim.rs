@@ -134,15 +134,15 @@ fn local_force_attracts_and_repels() {
     // A target to the north-east inside the field of view pulls that way.
     let target = vigil::geometry::Point::new(p.x + 20.0, p.y + 20.0);
     assert_eq!(
-        local_force_move(&s, 0, &[me], &[target]),
+        local_force_move(&s, 0, &[me], &[0], &[target]),
         Cell { col: 11, row: 11 }
     );
     // A sensor just west pushes east; nothing to do when alone.
     assert_eq!(
-        local_force_move(&s, 0, &[me, Cell { col: 9, row: 10 }], &[]),
+        local_force_move(&s, 0, &[me, Cell { col: 9, row: 10 }], &[0, 0], &[]),
         Cell { col: 11, row: 10 }
     );
-    assert_eq!(local_force_move(&s, 0, &[me], &[]), me);
+    assert_eq!(local_force_move(&s, 0, &[me], &[0], &[]), me);
 }
 
 /// A short run of every policy over HTTP against an in-process server:
@@ -162,6 +162,7 @@ async fn end_to_end_over_http() {
             scenario_id: info.id.clone(),
             scenario: scenario.clone(),
             sensors: 4,
+            fleet: None,
             steps: 15,
             warmup: 20,
             horizon: Some(2),
@@ -189,4 +190,172 @@ async fn end_to_end_over_http() {
         let (_, sim) = run_one(&client, cfg, 3, true).await.expect("run");
         assert_legal(&sim.expect("kept"));
     }
+}
+
+// Fleets: sensor types, speeds, no-go zones and Bernoulli detections.
+
+/// Within `speed` king moves of `from` through free cells? An independent
+/// breadth-first search.
+fn legal_step(s: &vigil::scenario::Scenario, from: Cell, to: Cell, speed: usize) -> bool {
+    let mut seen = std::collections::HashSet::from([from]);
+    let mut frontier = vec![from];
+    for _ in 0..speed {
+        let mut next = Vec::new();
+        for c in &frontier {
+            for dr in -1..=1 {
+                for dc in -1..=1 {
+                    let n = Cell {
+                        col: c.col + dc,
+                        row: c.row + dr,
+                    };
+                    if s.is_free(n) && seen.insert(n) {
+                        next.push(n);
+                    }
+                }
+            }
+        }
+        frontier = next;
+    }
+    s.is_free(to) && seen.contains(&to)
+}
+
+fn assert_fleet_legal(sim: &Sim) {
+    for (trace, &ty) in sim.trace.iter().zip(&sim.types) {
+        let speed = sim.scenario.types[ty].speed;
+        assert!(
+            sim.scenario.is_free(trace[0]),
+            "start {:?} blocked",
+            trace[0]
+        );
+        for w in trace.windows(2) {
+            assert!(
+                legal_step(&sim.scenario, w[0], w[1], speed),
+                "{:?} → {:?} at speed {speed}",
+                w[0],
+                w[1]
+            );
+        }
+    }
+}
+
+/// On `site-fleet`, the local policies and the planner (over HTTP) move
+/// drones and robots within their speeds and never onto no-go ground.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn fleets_move_within_their_speeds_around_no_go_zones() {
+    let s = builtins()
+        .into_iter()
+        .find(|s| s.id == "site-fleet")
+        .expect("built-in");
+    let types = vigil_sim::driver::fleet_types(&s, Some("drone:4,robot:6"), 10).expect("fleet");
+    assert!(s.has_no_go());
+    for policy in [Policy::Random, Policy::LocalForce] {
+        for start in [Start::Grid, Start::Random] {
+            let mut sim = Sim::with_types(s.clone(), types.clone(), start, 3, 4);
+            for _ in 0..60 {
+                sim.observe();
+                let next = sim.local_moves(policy);
+                sim.advance(next);
+            }
+            assert_fleet_legal(&sim);
+        }
+    }
+    let base = spawn_local_server().await.expect("server");
+    let client = Client::new(&base);
+    let cfg = RunConfig {
+        label: "fleet".into(),
+        policy: Policy::Exact,
+        scenario_id: s.id.clone(),
+        scenario: s.clone(),
+        sensors: 10,
+        fleet: Some("drone:4,robot:6".into()),
+        steps: 12,
+        warmup: 10,
+        horizon: Some(2),
+        history: 4,
+        start: Start::Grid,
+    };
+    let (metrics, sim) = run_one(&client, &cfg, 5, true).await.expect("run");
+    let sim = sim.expect("kept");
+    assert_fleet_legal(&sim);
+    // The drones moved more than one cell at some step.
+    let far = sim.trace[..4]
+        .iter()
+        .flat_map(|t| t.windows(2))
+        .any(|w| (w[0].col - w[1].col).abs().max((w[0].row - w[1].row).abs()) > 1);
+    assert!(far, "no drone ever used its speed");
+    assert!(metrics.ad > 0.0);
+}
+
+/// A sensor detects a target inside its field of view with its type's
+/// `p_detect`: over many (target, sensor, step) pairs the fraction
+/// detected is within four standard errors of `p` (counted independently
+/// from the world and the sensors' fields of view).
+#[test]
+fn detections_are_bernoulli_with_p_detect() {
+    let mut spec = vigil::scenario::paper_spec(10.0);
+    spec.p_detect = Some(0.5);
+    let s = vigil::scenario::Scenario::new(spec).expect("valid");
+    let (mut pairs, mut detected) = (0usize, 0usize);
+    for seed in 0..20 {
+        let mut sim = Sim::new(s.clone(), 6, Start::Grid, seed, 0);
+        for _ in 0..40 {
+            let stay = sim.sensors.clone();
+            sim.advance(stay);
+            let regions: Vec<_> = sim.sensors.iter().map(|&c| s.fov_region(c)).collect();
+            for (_, pos, n) in sim.detections() {
+                pairs += regions.iter().filter(|r| r.contains(pos)).count();
+                detected += n;
+            }
+        }
+    }
+    let p = detected as f64 / pairs as f64;
+    let se = (0.25 / pairs as f64).sqrt();
+    assert!(pairs > 5_000, "{pairs} pairs");
+    assert!((p - 0.5).abs() <= 4.0 * se, "p = {p} ± {se}");
+}
+
+/// Certain sensors draw nothing: a fleet of a named type identical to
+/// `default` (p 1) counts exactly what `default` sensors count, step by
+/// step, and the target stream is untouched.
+#[test]
+fn certain_fleets_count_exactly_as_default_sensors() {
+    let mut spec = vigil::scenario::paper_spec(10.0);
+    spec.sensor_types = Some(std::collections::BTreeMap::from([(
+        "twin".to_owned(),
+        vigil::scenario::SensorTypeSpec {
+            fov: spec.fov,
+            speed: None,
+            p_detect: None,
+        },
+    )]));
+    let s = vigil::scenario::Scenario::new(spec).expect("valid");
+    let twin = vigil_sim::driver::fleet_types(&s, Some("twin:4"), 4).expect("fleet");
+    let mut a = Sim::new(s.clone(), 4, Start::Grid, 9, 0);
+    let mut b = Sim::with_types(s.clone(), twin, Start::Grid, 9, 0);
+    for _ in 0..80 {
+        a.observe();
+        b.observe();
+        let (na, nb) = (
+            a.local_moves(Policy::LocalForce),
+            b.local_moves(Policy::LocalForce),
+        );
+        assert_eq!(na, nb);
+        assert_eq!(a.advance(na), b.advance(nb));
+    }
+}
+
+#[test]
+fn fleet_strings_are_checked() {
+    let s = builtins()
+        .into_iter()
+        .find(|s| s.id == "site-fleet")
+        .expect("built-in");
+    let types = |f: &str, n| vigil_sim::driver::fleet_types(&s, Some(f), n);
+    assert_eq!(types("drone:1,robot:2", 3).expect("ok").len(), 3);
+    assert!(types("tank:3", 3).unwrap_err().contains("tank"));
+    assert!(types("drone:3", 4).unwrap_err().contains("4"));
+    assert!(types("drone", 1).unwrap_err().contains("NAME:COUNT"));
+    assert!(types("drone:x", 1).unwrap_err().contains("count"));
+    assert_eq!(vigil_sim::driver::fleet_size("drone:4,robot:6"), Some(10));
+    assert_eq!(vigil_sim::driver::fleet_size("drone:4,robot"), None);
 }
