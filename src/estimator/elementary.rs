@@ -16,6 +16,10 @@ use rayon::prelude::*;
 use crate::geometry::{Point, Rect, wedge_inv_r_integral};
 use crate::scenario::{Cell, FovSpec, Heading, Scenario, Source};
 
+/// Elementary rectangles a grid may always have, whatever the lattice
+/// (a 32 MB prefix table).
+const MAX_SMALL_GRID: usize = 1 << 22;
+
 /// The grid, its prefix table of stationary mass, and each cell's block.
 #[derive(Debug, Clone)]
 pub struct ElementaryGrid {
@@ -199,7 +203,9 @@ fn stationary_prefix(s: &Scenario, xs: &[f64], ys: &[f64]) -> Vec<f64> {
 
 impl ElementaryGrid {
     /// The grid of a scenario whose sensor types all have square fields of
-    /// view (the breakpoints of every size); `None` when one is a circle.
+    /// view (the breakpoints of every size); `None` when one is a circle, or
+    /// when several sizes on a large lattice would make it larger than one
+    /// size can (then every value takes the general path).
     pub fn new(s: &Scenario) -> Option<Self> {
         let halves = s
             .fovs
@@ -212,6 +218,14 @@ impl ElementaryGrid {
         let xc = |c: i32| (c as f64 + 0.5) * s.cell_size;
         let xs = breakpoints((0..s.cols).map(xc), &halves, s.width);
         let ys = breakpoints((0..s.rows).map(xc), &halves, s.height);
+        // Several square sizes multiply the breakpoints. Past what one size
+        // can give on this lattice (or a small table), the grid's memory
+        // would grow with the number of sizes: such scenarios take the
+        // general path instead.
+        let one_size = (2 * s.cols as usize + 1) * (2 * s.rows as usize + 1);
+        if (xs.len() - 1) * (ys.len() - 1) > one_size.max(MAX_SMALL_GRID) {
+            return None;
+        }
         let span = |bp: &[f64], n: i32, extent: f64, h: f64| -> Vec<(usize, usize)> {
             (0..n)
                 .map(|c| {
@@ -377,8 +391,49 @@ pub(crate) fn trace(
 mod tests {
     use super::*;
     use crate::geometry::inv_r_integral;
-    use crate::scenario::{SourceSpec, builtins, paper_spec};
+    use crate::scenario::{Scenario, SourceSpec, builtins, paper_spec};
     use crate::stats::Stats;
+
+    #[test]
+    fn several_square_sizes_share_one_grid_within_a_bound() {
+        use crate::scenario::SensorTypeSpec;
+        let with_sizes = |cells: f64, sizes: &[f64]| {
+            let mut spec = paper_spec(10.0);
+            spec.cell_size = 300.0 / cells;
+            spec.sensor_types = Some(
+                sizes
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &h)| {
+                        (
+                            format!("t{i}"),
+                            SensorTypeSpec {
+                                fov: FovSpec::Square { half_width: h },
+                                speed: None,
+                                p_detect: None,
+                            },
+                        )
+                    })
+                    .collect(),
+            );
+            Scenario::new(spec).expect("valid")
+        };
+        // Small lattice: one grid holds every size's edges, and each size's
+        // blocks are its cells' fields of view.
+        let s = with_sizes(30.0, &[17.3, 41.9]);
+        let g = ElementaryGrid::new(&s).expect("a grid");
+        for slot in 0..s.fovs.len() {
+            let c = Cell { col: 12, row: 7 };
+            let (a0, a1, b0, b1) = g.span(slot, c);
+            let r = s.fov_with(s.fovs[slot], s.centre(c)).rect;
+            assert!((g.xs[a0] - r.x0).abs() < 1e-9 && (g.xs[a1] - r.x1).abs() < 1e-9);
+            assert!((g.ys[b0] - r.y0).abs() < 1e-9 && (g.ys[b1] - r.y1).abs() < 1e-9);
+        }
+        // A large lattice with many sizes off the cell grid would need far
+        // more rectangles than one size: no grid (the general path).
+        let s = with_sizes(1000.0, &[3.3, 5.7, 7.1, 9.9, 11.3]);
+        assert!(ElementaryGrid::new(&s).is_none());
+    }
 
     #[test]
     fn block_masses_are_the_cells_d_hat() {
