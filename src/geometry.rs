@@ -393,6 +393,22 @@ pub fn detection_within(
     hi: f64,
     events: &mut Vec<(f64, f64, bool)>,
 ) -> f64 {
+    let mut detected = 0.0;
+    detection_pieces(intervals, lo, hi, events, |a, b, p| detected += (b - a) * p);
+    detected
+}
+
+/// Cuts `[lo, hi] ∩ ⋃ intervals` into pieces with one detection probability
+/// each, `1 − Π (1 − p)` over the intervals `(a, b, p)` that hold it, and
+/// calls `piece(a, b, detected)` for each in order. `events` is scratch
+/// space.
+pub fn detection_pieces(
+    intervals: &[(f64, f64, f64)],
+    lo: f64,
+    hi: f64,
+    events: &mut Vec<(f64, f64, bool)>,
+    mut piece: impl FnMut(f64, f64, f64),
+) {
     // Events (x, p, opens), swept in x order; the miss probability of the
     // open intervals is kept as a count of certain ones and a sum of
     // ln(1 − p) over the others.
@@ -406,15 +422,13 @@ pub fn detection_within(
     }
     events.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
     let (mut open, mut certain, mut log_miss) = (0usize, 0usize, 0.0f64);
-    let mut detected = 0.0;
     let mut prev = lo;
     for &(x, p, opens) in events.iter() {
         if open > 0 && x > prev {
             let miss = if certain > 0 { 0.0 } else { log_miss.exp() };
-            detected += (x - prev) * (1.0 - miss);
+            piece(prev, x, 1.0 - miss);
         }
         prev = x;
-        let sign = if opens { 1.0 } else { -1.0 };
         if opens {
             open += 1;
         } else {
@@ -427,13 +441,13 @@ pub fn detection_within(
                 certain -= 1;
             }
         } else {
-            log_miss += sign * (-p).ln_1p();
+            let l = (-p).ln_1p();
+            log_miss += if opens { l } else { -l };
         }
         if open == 0 {
             log_miss = 0.0;
         }
     }
-    detected
 }
 
 /// ∫∫ over the rectangle `[x0,x1]×[y0,y1]` (coordinates relative to the

@@ -10,6 +10,7 @@
 
 use super::rays::SourceRays;
 use super::{max, min};
+use crate::geometry::detection_pieces;
 use crate::scenario::{Look, all_certain};
 
 /// What the rays of one source saw: per ray, the union of the intervals
@@ -63,62 +64,33 @@ impl RayHits {
         let mut hits: Vec<(f64, f64)> = Vec::new();
         let mut detected: Vec<f64> = Vec::new();
         let mut events: Vec<(f64, f64, bool)> = Vec::new();
+        let mut intervals: Vec<(f64, f64, f64)> = Vec::new();
         let mut i = 0;
         for m in 0..n {
             let start = i;
             while i < pieces.len() && pieces[i].0 as usize == m {
                 i += 1;
             }
-            events.clear();
-            for &(_, p, q, pd) in &pieces[start..i] {
-                if q > p {
-                    events.push((p, pd, true));
-                    events.push((q, pd, false));
-                }
-            }
-            events.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
-            let (mut open, mut certain, mut log_miss) = (0usize, 0usize, 0.0f64);
-            let mut prev = f64::NEG_INFINITY;
-            for &(x, pd, opens) in &events {
-                if open > 0 && x > prev {
-                    let seen = if certain > 0 {
-                        1.0
-                    } else {
-                        1.0 - log_miss.exp()
-                    };
+            intervals.clear();
+            intervals.extend(pieces[start..i].iter().map(|&(_, p, q, pd)| (p, q, pd)));
+            let first = hits.len();
+            detection_pieces(
+                &intervals,
+                f64::NEG_INFINITY,
+                f64::INFINITY,
+                &mut events,
+                |a, b, seen| {
                     // A piece that continues the last one of this ray at
                     // the same probability extends it.
-                    let ours = hits.len() > offsets[m] as usize;
-                    match (hits.last_mut(), detected.last()) {
-                        (Some(last), Some(&d)) if ours && last.1 == prev && d == seen => {
-                            last.1 = x;
-                        }
+                    match (hits[first..].last_mut(), detected.last()) {
+                        (Some(last), Some(&d)) if last.1 == a && d == seen => last.1 = b,
                         _ => {
-                            hits.push((prev, x));
+                            hits.push((a, b));
                             detected.push(seen);
                         }
                     }
-                }
-                prev = x;
-                if opens {
-                    open += 1;
-                } else {
-                    open -= 1;
-                }
-                if pd >= 1.0 {
-                    if opens {
-                        certain += 1;
-                    } else {
-                        certain -= 1;
-                    }
-                } else {
-                    let l = (-pd).ln_1p();
-                    log_miss += if opens { l } else { -l };
-                }
-                if open == 0 {
-                    log_miss = 0.0;
-                }
-            }
+                },
+            );
             offsets[m + 1] = hits.len() as u32;
         }
         RayHits {
