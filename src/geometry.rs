@@ -409,43 +409,39 @@ pub fn detection_pieces(
     events: &mut Vec<(f64, f64, bool)>,
     mut piece: impl FnMut(f64, f64, f64),
 ) {
-    // Events (x, p, opens), swept in x order; the miss probability of the
-    // open intervals is kept as a count of certain ones and a sum of
-    // ln(1 − p) over the others.
+    // Events (x, 1 − p, opens), swept in x order; the miss probability of
+    // the open intervals is kept as a count of certain ones (p = 1) and the
+    // product of 1 − p over the others, divided out again on closing (and
+    // reset when nothing is open, so rounding cannot accumulate).
     events.clear();
     for &(a, b, p) in intervals {
         let (a, b) = (a.max(lo), b.min(hi));
         if b > a {
-            events.push((a, p, true));
-            events.push((b, p, false));
+            events.push((a, 1.0 - p, true));
+            events.push((b, 1.0 - p, false));
         }
     }
     events.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
-    let (mut open, mut certain, mut log_miss) = (0usize, 0usize, 0.0f64);
+    let (mut open, mut certain, mut miss) = (0usize, 0usize, 1.0f64);
     let mut prev = lo;
-    for &(x, p, opens) in events.iter() {
+    for &(x, q, opens) in events.iter() {
         if open > 0 && x > prev {
-            let miss = if certain > 0 { 0.0 } else { log_miss.exp() };
-            piece(prev, x, 1.0 - miss);
+            piece(prev, x, if certain > 0 { 1.0 } else { 1.0 - miss });
         }
         prev = x;
+        match (opens, q <= 0.0) {
+            (true, true) => certain += 1,
+            (false, true) => certain -= 1,
+            (true, false) => miss *= q,
+            (false, false) => miss /= q,
+        }
         if opens {
             open += 1;
         } else {
             open -= 1;
-        }
-        if p >= 1.0 {
-            if opens {
-                certain += 1;
-            } else {
-                certain -= 1;
+            if open == 0 {
+                miss = 1.0;
             }
-        } else {
-            let l = (-p).ln_1p();
-            log_miss += if opens { l } else { -l };
-        }
-        if open == 0 {
-            log_miss = 0.0;
         }
     }
 }

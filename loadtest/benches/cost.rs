@@ -31,11 +31,16 @@ fn checked(planner: &Planner, req: &PlanRequest) {
     let resp = planner.plan_request(req).unwrap();
     let horizon = req.horizon.as_ref().and_then(|h| h.get()).unwrap() as usize;
     assert_eq!(resp.plans.len(), req.sensors.len());
-    for p in &resp.plans {
+    for (p, sensor) in resp.plans.iter().zip(&req.sensors) {
         assert_eq!(p.path.len(), horizon);
+        let ty = planner
+            .scenario
+            .type_index(sensor.sensor_type.as_deref().unwrap_or("default"))
+            .unwrap();
+        let speed = planner.scenario.types[ty].speed as i32;
         let mut prev = (p.start.col, p.start.row);
         for c in &p.path {
-            assert!((c.col - prev.0).abs() <= 1 && (c.row - prev.1).abs() <= 1);
+            assert!((c.col - prev.0).abs() <= speed && (c.row - prev.1).abs() <= speed);
             prev = (c.col, c.row);
         }
     }
@@ -253,6 +258,27 @@ fn speed_classes(c: &mut Criterion) {
     g.finish();
 }
 
+/// `plan_fleet/F`: `site-fleet` (robots and drones around no-go zones)
+/// with the fleets of `vigil-sim --experiment fleet`: ten robots (F = 0),
+/// four drones and six robots (1), ten drones (2). Each fleet's own run
+/// gives its 4 requests (16 steps of history, exact + priority, T = 3).
+fn fleets(c: &mut Criterion) {
+    let planner = Planner::new(
+        builtins()
+            .into_iter()
+            .find(|s| s.id == "site-fleet")
+            .expect("a built-in"),
+    );
+    let mut g = group(c, "plan_fleet");
+    for (f, fleet) in vigil_sim::experiment::FLEETS.iter().enumerate() {
+        let types = vigil_sim::driver::fleet_types(&planner.scenario, Some(fleet), 10)
+            .expect("a fleet of the scenario");
+        let reqs = Workload::reference().requests_of_fleet(&planner, 4, types);
+        bench_requests(&mut g, &planner, f, &reqs);
+    }
+    g.finish();
+}
+
 criterion_group!(
     benches,
     horizon,
@@ -260,6 +286,7 @@ criterion_group!(
     targets,
     history,
     speed_classes,
+    fleets,
     precompute
 );
 criterion_main!(benches);

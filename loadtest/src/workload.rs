@@ -44,14 +44,22 @@ impl Workload {
     /// # Panics
     /// If the planner refuses a request the simulator built (a bug).
     pub fn requests(&self, planner: &Planner, count: usize) -> Vec<PlanRequest> {
+        self.requests_of_fleet(planner, count, vec![0; self.sensors])
+    }
+
+    /// The same with sensors of the scenario's types `types` (one entry per
+    /// sensor; `self.sensors` is ignored).
+    ///
+    /// # Panics
+    /// As [`Workload::requests`].
+    pub fn requests_of_fleet(
+        &self,
+        planner: &Planner,
+        count: usize,
+        types: Vec<usize>,
+    ) -> Vec<PlanRequest> {
         let s: &Scenario = &planner.scenario;
-        let mut sim = Sim::new(
-            s.clone(),
-            self.sensors,
-            Start::Grid,
-            self.seed,
-            self.history,
-        );
+        let mut sim = Sim::with_types(s.clone(), types, Start::Grid, self.seed, self.history);
         for _ in 0..default_warmup(s).max(self.history) {
             sim.observe();
             let stay = sim.sensors.clone();

@@ -59,7 +59,21 @@ impl RayHits {
                 }
             }
         }
-        pieces.sort_unstable_by_key(|x| x.0);
+        // By ray: a counting sort (the pieces of one ray keep their order).
+        let mut counts = vec![0usize; n + 1];
+        for &(m, ..) in &pieces {
+            counts[m as usize + 1] += 1;
+        }
+        for m in 0..n {
+            counts[m + 1] += counts[m];
+        }
+        let mut sorted = vec![(0u32, 0.0, 0.0, 0.0); pieces.len()];
+        for &piece in &pieces {
+            let slot = &mut counts[piece.0 as usize];
+            sorted[*slot] = piece;
+            *slot += 1;
+        }
+        let pieces = sorted;
         let mut offsets = vec![0u32; n + 1];
         let mut hits: Vec<(f64, f64)> = Vec::new();
         let mut detected: Vec<f64> = Vec::new();
