@@ -19,6 +19,16 @@
 //! against all the others for the exact estimator; for the paper estimator
 //! also the change in the lower-ranked sensors' overlap reductions), so each
 //! accepted change raises the total and it never ends below `Priority`.
+//!
+//! With a minimum separation `d > 0` ([`crate::separation`]) every mode
+//! keeps the sensors apart: paths are fixed in rank order, and each sensor
+//! after the first searches with the fixed paths' cells marked as
+//! violations, minimising (violations, −value) lexicographically. `None`
+//! still ignores the others' values, but not their positions. In
+//! `Iterated` a sensor's search counts violations against every other
+//! sensor's current path, and a new path is taken when it has fewer
+//! violations, or as many and more value, so each change lowers the
+//! number of pairs too close or keeps it and raises the total.
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -28,6 +38,7 @@ use crate::estimator::Estimator;
 use crate::geometry::Region;
 use crate::scenario::{Cell, FovSpec, Look, Scenario};
 use crate::search::{BestPath, ValueGrid, best_path};
+use crate::separation::{self, Violations, mark_too_close};
 
 /// How sensors' searches are coordinated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema)]
@@ -52,6 +63,9 @@ pub struct SensorPlan {
     pub path: Vec<Cell>,
     /// The value its final search maximised.
     pub value: f64,
+    /// The violations of the separation rule that search counted against
+    /// the paths it planned around.
+    pub violations: u32,
     /// The values that search used.
     pub grid: ValueGrid,
 }
@@ -67,10 +81,15 @@ pub struct Coordinated {
     pub by_step: Vec<f64>,
     /// Best-response rounds run (iterated only).
     pub rounds: usize,
+    /// Breaches of the minimum separation among the final paths.
+    pub violations: Violations,
 }
 
 /// Plans `starts.len()` sensors of types `types` over `horizon` steps; each
-/// moves at its type's speed through the scenario's free cells.
+/// moves at its type's speed through the scenario's free cells, and keeps
+/// the minimum separation `min_separation` (cells; 0 for none) from the
+/// others wherever it can (see the module docs).
+#[allow(clippy::too_many_arguments)]
 pub fn coordinate(
     s: &Scenario,
     est: &dyn Estimator,
@@ -78,6 +97,7 @@ pub fn coordinate(
     types: &[usize],
     horizon: usize,
     mode: Coordination,
+    min_separation: usize,
 ) -> Coordinated {
     let n = starts.len();
     // Each sensor's motion (its speed, the free cells around it), built
@@ -94,13 +114,27 @@ pub fn coordinate(
             })
         })
         .collect();
-    let plan_one = |i: usize, fill: &mut dyn FnMut(usize, &mut ValueGrid)| {
-        search(&motions[i], starts[i], fill)
+    let d = min_separation;
+    let plan_one = |i: usize, fill: &mut dyn FnMut(usize, &mut ValueGrid), avoid: Vec<&[Cell]>| {
+        let mut grid = motions[i].clone();
+        for t in 1..=grid.horizon() {
+            fill(t, &mut grid);
+        }
+        mark_too_close(&mut grid, starts[i], d, avoid);
+        search(grid, starts[i])
     };
+    // The paths of `sensors`, when there is a separation to keep.
+    let paths =
+        |plans: &[SensorPlan], sensors: &mut dyn Iterator<Item = usize>| -> Vec<Vec<Cell>> {
+            if d == 0 {
+                return Vec::new();
+            }
+            sensors.map(|q| plans[q].path.clone()).collect()
+        };
     // Every sensor alone.
     let mut plans: Vec<SensorPlan> = (0..n)
         .into_par_iter()
-        .map(|i| plan_one(i, &mut |t, g| est.fill(i, starts[i], t, &[], g)))
+        .map(|i| plan_one(i, &mut |t, g| est.fill(i, starts[i], t, &[], g), Vec::new()))
         .collect();
     let mut order: Vec<usize> = (0..n).collect();
     // Stable sort: ties keep request order.
@@ -113,9 +147,25 @@ pub fn coordinate(
             let above = &order[..rank];
             let plan = {
                 let looks = looks_by_step(s, &plans, types, above, horizon, i, starts[i]);
-                plan_one(i, &mut |t, g| est.fill(i, starts[i], t, &looks[t - 1], g))
+                let avoid = paths(&plans, &mut above.iter().copied());
+                plan_one(
+                    i,
+                    &mut |t, g| est.fill(i, starts[i], t, &looks[t - 1], g),
+                    avoid.iter().map(Vec::as_slice).collect(),
+                )
             };
             plans[i] = plan;
+        }
+    } else if d > 0 {
+        // No coordination, but apart: each sensor keeps its own values and
+        // plans around the positions of the ones above it.
+        for rank in 1..order.len() {
+            let i = order[rank];
+            let avoid = paths(&plans, &mut order[..rank].iter().copied());
+            let mut grid = std::mem::replace(&mut plans[i].grid, motions[i].clone());
+            grid.clear_violations();
+            mark_too_close(&mut grid, starts[i], d, avoid.iter().map(Vec::as_slice));
+            plans[i] = search(grid, starts[i]);
         }
     }
     if mode == Coordination::Iterated {
@@ -125,33 +175,49 @@ pub fn coordinate(
             rounds += 1;
             for rank in 0..order.len() {
                 let i = order[rank];
+                let avoid = paths(&plans, &mut (0..n).filter(|&j| j != i));
+                let avoid = avoid.iter().map(Vec::as_slice).collect();
                 let grid_plan = if est.order_independent() {
                     let others: Vec<usize> = order.iter().copied().filter(|&j| j != i).collect();
                     let looks = looks_by_step(s, &plans, types, &others, horizon, i, starts[i]);
-                    plan_one(i, &mut |t, g| est.fill(i, starts[i], t, &looks[t - 1], g))
+                    plan_one(
+                        i,
+                        &mut |t, g| est.fill(i, starts[i], t, &looks[t - 1], g),
+                        avoid,
+                    )
                 } else {
-                    plan_one(i, &mut |t, g| {
-                        g.fill_step(t, |dc, dr| {
-                            let k = Cell {
-                                col: starts[i].col + dc,
-                                row: starts[i].row + dr,
-                            };
-                            Some(total_change(s, est, &plans, types, &order, rank, k, t))
-                        });
-                    })
+                    plan_one(
+                        i,
+                        &mut |t, g| {
+                            g.fill_step(t, |dc, dr| {
+                                let k = Cell {
+                                    col: starts[i].col + dc,
+                                    row: starts[i].row + dr,
+                                };
+                                Some(total_change(s, est, &plans, types, &order, rank, k, t))
+                            });
+                        },
+                        avoid,
+                    )
                 };
                 let current = path_moves(starts[i], &plans[i].path);
                 let current_value = grid_plan
                     .grid
                     .path_value(&current)
                     .unwrap_or(f64::NEG_INFINITY);
+                let current_violations =
+                    grid_plan.grid.path_violations(&current).unwrap_or(u32::MAX);
                 let tol = 1e-9 * current_value.abs().max(1.0);
-                if grid_plan.value > current_value + tol {
+                if grid_plan.violations < current_violations
+                    || (grid_plan.violations == current_violations
+                        && grid_plan.value > current_value + tol)
+                {
                     plans[i] = grid_plan;
                     changed = true;
                 } else {
                     plans[i] = SensorPlan {
                         value: current_value,
+                        violations: current_violations,
                         path: std::mem::take(&mut plans[i].path),
                         grid: grid_plan.grid,
                     };
@@ -174,11 +240,14 @@ pub fn coordinate(
                 .sum()
         })
         .collect();
+    let violations =
+        separation::count(&plans.iter().map(|p| p.path.clone()).collect::<Vec<_>>(), d);
     Coordinated {
         plans,
         order,
         by_step,
         rounds,
+        violations,
     }
 }
 
@@ -277,18 +346,13 @@ fn path_moves(start: Cell, path: &[Cell]) -> Vec<(i32, i32)> {
         .collect()
 }
 
-/// Fills a value grid step by step with `fill(t, grid)` and searches it,
-/// for a sensor of speed `speed` that may stand on the free cells only.
-fn search(
-    motion: &ValueGrid,
-    start: Cell,
-    fill: &mut dyn FnMut(usize, &mut ValueGrid),
-) -> SensorPlan {
-    let mut grid = motion.clone();
-    for t in 1..=grid.horizon() {
-        fill(t, &mut grid);
-    }
-    let BestPath { moves, value } = best_path(&grid);
+/// Searches a filled value grid of a sensor starting at `start`.
+fn search(grid: ValueGrid, start: Cell) -> SensorPlan {
+    let BestPath {
+        moves,
+        value,
+        violations,
+    } = best_path(&grid);
     let mut c = start;
     let path = moves
         .iter()
@@ -300,5 +364,10 @@ fn search(
             c
         })
         .collect();
-    SensorPlan { path, value, grid }
+    SensorPlan {
+        path,
+        value,
+        violations,
+        grid,
+    }
 }

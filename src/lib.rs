@@ -9,6 +9,7 @@
 //! - [`estimator`]: `n̂(k,t)`, by the paper's equations or exactly;
 //! - [`search`]: the best T-step path of one sensor (dynamic programming);
 //! - [`coordination`]: priority and iterated coordination of several sensors;
+//! - [`separation`]: the minimum separation between sensors, counted and kept;
 //! - [`planner`]: a scenario's planner and the request/response types;
 //! - [`world`]: a simulation of the target process, for checks and simulators.
 //!
@@ -22,6 +23,7 @@ pub mod http;
 pub mod planner;
 pub mod scenario;
 pub mod search;
+pub mod separation;
 pub mod stats;
 pub mod store;
 pub mod world;

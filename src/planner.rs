@@ -16,6 +16,7 @@ use crate::estimator::{
 use crate::geometry::Point;
 use crate::scenario::{
     Cell, DEFAULT_TYPE, Integer, Look, Scenario, ValidationError, check_horizon,
+    check_min_separation,
 };
 use crate::stats::Stats;
 
@@ -163,6 +164,12 @@ pub struct PlanRequest {
     /// Include the search values in the response.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub explain: Option<bool>,
+    /// Minimum separation between sensors at every step of the plan,
+    /// cells (Chebyshev distance; 0..=16, 0 = no rule); the scenario's by
+    /// default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<u32>, minimum = 0, maximum = 16)]
+    pub min_separation: Option<Integer>,
 }
 
 /// A lattice cell and its centre.
@@ -199,6 +206,9 @@ pub struct PlanOut {
     pub path: Vec<CellOut>,
     /// The value its final search maximised.
     pub expected_detections: f64,
+    /// The (step, other sensor) pairs at which its path is closer to
+    /// another sensor's than `min_separation` allows.
+    pub separation_violations: u32,
     /// Search values, when asked for.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub explain: Option<Explain>,
@@ -215,6 +225,12 @@ pub struct PlanResponse {
     pub estimator: EstimatorKind,
     /// Coordination used.
     pub coordination: Coordination,
+    /// Minimum separation kept, cells (0: none).
+    pub min_separation: usize,
+    /// The (step, pair of sensors) at which two paths are closer than
+    /// `min_separation` allows, each pair once per step (half the sum of
+    /// the plans' counts).
+    pub separation_violations: u32,
     /// Plans in request order.
     pub plans: Vec<PlanOut>,
     /// Expected distinct targets detected over steps 1..=T.
@@ -239,6 +255,7 @@ pub struct PlanInput {
     coordination: Coordination,
     observed: Observed,
     explain: bool,
+    min_separation: usize,
 }
 
 fn finite(field: impl Fn() -> String, v: f64) -> Result<f64, ValidationError> {
@@ -370,7 +387,10 @@ impl PlanInput {
             );
         }
         let horizon = check_horizon("horizon", req.horizon.as_ref(), s.horizon)?;
+        let min_separation = check_min_separation("min_separation", req.min_separation.as_ref())?
+            .unwrap_or(s.min_separation);
         Ok(PlanInput {
+            min_separation,
             ids,
             starts,
             types,
@@ -486,6 +506,7 @@ impl Planner {
             &input.types,
             input.horizon,
             input.coordination,
+            input.min_separation,
         );
         let cell_out = |c: Cell| {
             let p = s.centre(c);
@@ -510,6 +531,7 @@ impl Planner {
                 start: cell_out(input.starts[i]),
                 path: p.path.iter().map(|&c| cell_out(c)).collect(),
                 expected_detections: p.value,
+                separation_violations: result.violations.per_sensor[i],
                 explain: input.explain.then(|| Explain {
                     values: p.grid.to_nested(),
                 }),
@@ -520,6 +542,8 @@ impl Planner {
             horizon: input.horizon,
             estimator: input.estimator,
             coordination: input.coordination,
+            min_separation: input.min_separation,
+            separation_violations: result.violations.pairs,
             plans,
             expected_detections: result.by_step.iter().sum(),
             expected_by_step: result.by_step,

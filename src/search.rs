@@ -35,6 +35,15 @@
 //! are a whole square, so the maximum is taken separably (rows, then
 //! columns) in `O(T·(2mT+1)²·(2m+1))`.
 //!
+//! # Separation
+//!
+//! A grid may also carry *violation counts* per (step, offset): how many
+//! other sensors a path ending a step there would be too close to (see
+//! [`crate::separation`]). With any count set, a path's score is the pair
+//! (violations, value), compared lexicographically: fewer violations first,
+//! then more value. The same programme finds that optimum, since both parts
+//! add along a path; without counts it is the plain value, as before.
+//!
 //! # Tie-breaking
 //!
 //! Ties are broken deterministically: among optimal paths, the one whose
@@ -308,6 +317,8 @@ pub struct ValueGrid {
     motion: Arc<Motion>,
     /// `values[(t−1)·side² + index]`.
     values: Vec<Option<f64>>,
+    /// Violation counts, indexed as `values`; empty when none is set.
+    violations: Vec<u16>,
 }
 
 impl ValueGrid {
@@ -377,6 +388,7 @@ impl ValueGrid {
         Self {
             motion,
             values: vec![None; len],
+            violations: Vec::new(),
         }
     }
 
@@ -468,6 +480,60 @@ impl ValueGrid {
         self.slot(t, dc, dr).and_then(|i| self.values[i])
     }
 
+    /// Adds one violation at step `t` (1-based) to every offset `(dc, dr)`
+    /// with `dc` in `cols` and `dr` in `rows` (clipped to the square of
+    /// offsets): ending step `t` there would be too close to one more
+    /// sensor. Steps outside `1..=T` are ignored.
+    pub fn add_violations(
+        &mut self,
+        t: usize,
+        cols: std::ops::RangeInclusive<i32>,
+        rows: std::ops::RangeInclusive<i32>,
+    ) {
+        if t == 0 || t > self.horizon() {
+            return;
+        }
+        let e = self.motion.extent();
+        let (c0, c1) = ((*cols.start()).max(-e), (*cols.end()).min(e));
+        let (r0, r1) = ((*rows.start()).max(-e), (*rows.end()).min(e));
+        if c0 > c1 || r0 > r1 {
+            return;
+        }
+        if self.violations.is_empty() {
+            self.violations = vec![0; self.values.len()];
+        }
+        let side = self.side();
+        let base = (t - 1) * side * side;
+        for dr in r0..=r1 {
+            let row = base + (dr + e) as usize * side;
+            for v in &mut self.violations[row + (c0 + e) as usize..=row + (c1 + e) as usize] {
+                *v = v.saturating_add(1);
+            }
+        }
+    }
+
+    /// Removes every violation count.
+    pub fn clear_violations(&mut self) {
+        self.violations.clear();
+    }
+
+    /// True when some violation count is set (the search is then
+    /// lexicographic; see the module docs).
+    pub fn has_violations(&self) -> bool {
+        !self.violations.is_empty()
+    }
+
+    /// The violation count at step `t` and offset `(dc, dr)` (0 outside the
+    /// square or the horizon).
+    pub fn violations(&self, t: usize, dc: i32, dr: i32) -> u32 {
+        if self.violations.is_empty() || t == 0 || t > self.horizon() {
+            return 0;
+        }
+        self.motion.index(dc, dr).map_or(0, |i| {
+            u32::from(self.violations[(t - 1) * self.side() * self.side() + i])
+        })
+    }
+
     /// `values[t−1][dr+m·T][dc+m·T]`, `None` where unreachable, not free or
     /// unset; each step is `side × side`.
     pub fn to_nested(&self) -> Vec<Vec<Vec<Option<f64>>>> {
@@ -498,6 +564,22 @@ impl ValueGrid {
         }
         Some(total)
     }
+
+    /// Sum of the violation counts along a sequence of per-step
+    /// displacements, or `None` when [`ValueGrid::path_value`] would be.
+    pub fn path_violations(&self, moves: &[(i32, i32)]) -> Option<u32> {
+        self.path_value(moves)?;
+        let mut o = self.motion.start();
+        let n = self.side() * self.side();
+        let mut total = 0;
+        for (t, &d) in moves.iter().enumerate() {
+            o = self.motion.step(o, d)?;
+            if !self.violations.is_empty() {
+                total += u32::from(self.violations[t * n + o]);
+            }
+        }
+        Some(total)
+    }
 }
 
 /// An optimal path: the moves of steps 1..=T and their total value.
@@ -507,6 +589,9 @@ pub struct BestPath {
     pub moves: Vec<(i32, i32)>,
     /// Sum of the grid values along the path (`-∞` if there is no path).
     pub value: f64,
+    /// Sum of the grid's violation counts along the path (0 when the grid
+    /// has none, or there is no path).
+    pub violations: u32,
 }
 
 impl BestPath {
@@ -524,36 +609,125 @@ impl BestPath {
     }
 }
 
+/// A path's score in the programme: its value, or with violation counts
+/// (see the module docs) the pair (violations, value) in lexicographic
+/// order. [`Score::NONE`] is "no path", below every real score.
+trait Score: Copy {
+    const NONE: Self;
+    /// The score of ending a step at flat index `i`, if it has a value.
+    fn at(grid: &ValueGrid, i: usize) -> Option<Self>;
+    fn add(self, other: Self) -> Self;
+    /// Strictly better.
+    fn better(self, other: Self) -> bool;
+    fn max(self, other: Self) -> Self;
+}
+
+impl Score for f64 {
+    const NONE: Self = f64::NEG_INFINITY;
+    #[inline(always)]
+    fn at(grid: &ValueGrid, i: usize) -> Option<Self> {
+        grid.values[i]
+    }
+    #[inline(always)]
+    fn add(self, other: Self) -> Self {
+        self + other
+    }
+    #[inline(always)]
+    fn better(self, other: Self) -> bool {
+        self > other
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        f64::max(self, other)
+    }
+}
+
+/// (violations, value), violations negated so that both parts are
+/// maximised; "no path" is `-∞` in both, and stays so under addition.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Lex {
+    neg_violations: f64,
+    value: f64,
+}
+
+impl Score for Lex {
+    const NONE: Self = Lex {
+        neg_violations: f64::NEG_INFINITY,
+        value: f64::NEG_INFINITY,
+    };
+    #[inline(always)]
+    fn at(grid: &ValueGrid, i: usize) -> Option<Self> {
+        grid.values[i].map(|value| Lex {
+            neg_violations: -f64::from(grid.violations[i]),
+            value,
+        })
+    }
+    #[inline(always)]
+    fn add(self, other: Self) -> Self {
+        Lex {
+            neg_violations: self.neg_violations + other.neg_violations,
+            value: self.value + other.value,
+        }
+    }
+    #[inline(always)]
+    fn better(self, other: Self) -> bool {
+        self.neg_violations > other.neg_violations
+            || (self.neg_violations == other.neg_violations && self.value > other.value)
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        if other.better(self) { other } else { self }
+    }
+}
+
 /// The optimal path by dynamic programming over the space-time lattice (see
-/// the module docs), with the tie-breaking of [`brute_force`].
+/// the module docs), with the tie-breaking of [`brute_force`]. With
+/// violation counts on the grid it minimises (violations, −value)
+/// lexicographically.
 ///
 /// Cells with no value are never entered (they may be passed through within
 /// a step if free). Staying put is always legal, so a path exists whenever
 /// the start's own cell has values at every step. With no path at all, the
 /// moves are all `(0, 0)` and the value is `-∞`.
 pub fn best_path(grid: &ValueGrid) -> BestPath {
+    let moves = if grid.violations.is_empty() {
+        programme::<f64>(grid)
+    } else {
+        programme::<Lex>(grid)
+    };
+    // The value is summed in step order, as brute force sums it.
+    let value = grid.path_value(&moves);
+    BestPath {
+        violations: value.and(grid.path_violations(&moves)).unwrap_or(0),
+        value: value.unwrap_or(f64::NEG_INFINITY),
+        moves,
+    }
+}
+
+/// The programme of [`best_path`] over scores `S`: the optimal moves.
+fn programme<S: Score>(grid: &ValueGrid) -> Vec<(i32, i32)> {
     let mo = &*grid.motion;
     let (h, side, speed) = (mo.horizon, mo.side, mo.speed);
     let n = side * side;
     let e = speed * h;
-    // best[(t−1)·n + o] for t = 1..=T; -∞ where there is no path from (o, t).
-    let mut best = vec![f64::NEG_INFINITY; h * n];
+    // best[(t−1)·n + o] for t = 1..=T; NONE where there is no path from (o, t).
+    let mut best = vec![S::NONE; h * n];
     let mut rowmax = if mo.open && h > 1 {
-        vec![f64::NEG_INFINITY; n]
+        vec![S::NONE; n]
     } else {
         Vec::new()
     };
     for t in (1..=h).rev() {
         let (done, later) = best.split_at_mut(t * n);
         let cur = &mut done[(t - 1) * n..];
-        let vals = &grid.values[(t - 1) * n..t * n];
+        let base = (t - 1) * n;
         let k = speed * t;
         let rows = e - k..=e + k;
         let cols = move |r: usize| r * side + e - k..=r * side + e + k;
         if t == h {
             for r in rows {
                 for o in cols(r) {
-                    if let Some(v) = vals[o] {
+                    if let Some(v) = S::at(grid, base + o) {
                         cur[o] = v;
                     }
                 }
@@ -562,34 +736,36 @@ pub fn best_path(grid: &ValueGrid) -> BestPath {
         }
         let next = &later[..n];
         if mo.open {
-            let layer = match speed {
-                1 => open_layer::<1>,
-                2 => open_layer::<2>,
-                _ => open_layer::<3>,
-            };
-            layer(side, e - k, e + k, vals, next, &mut rowmax, cur);
+            let (lo, hi) = (e - k, e + k);
+            match speed {
+                1 => open_layer::<1, S>(grid, base, side, lo, hi, next, &mut rowmax, cur),
+                2 => open_layer::<2, S>(grid, base, side, lo, hi, next, &mut rowmax, cur),
+                _ => open_layer::<3, S>(grid, base, side, lo, hi, next, &mut rowmax, cur),
+            }
         } else {
             for r in rows {
                 for o in cols(r) {
-                    let Some(v) = vals[o] else { continue };
-                    cur[o] = v + mo
-                        .successors(o)
-                        .iter()
-                        .fold(f64::NEG_INFINITY, |a, &s| a.max(next[s as usize]));
+                    let Some(v) = S::at(grid, base + o) else {
+                        continue;
+                    };
+                    cur[o] = v.add(
+                        mo.successors(o)
+                            .iter()
+                            .fold(S::NONE, |a, &s| a.max(next[s as usize])),
+                    );
                 }
             }
         }
     }
     let mut o = mo.start();
     let mut moves = Vec::with_capacity(h);
-    let mut value = Some(0.0);
     for t in 1..=h {
         let row = &best[(t - 1) * n..t * n];
         let mut choice = o;
-        let mut top = f64::NEG_INFINITY;
+        let mut top = S::NONE;
         for &s in mo.successors(o) {
             let b = row[s as usize];
-            if b > top {
+            if b.better(top) {
                 top = b;
                 choice = s as usize;
             }
@@ -599,30 +775,29 @@ pub fn best_path(grid: &ValueGrid) -> BestPath {
             (choice / side) as i32 - (o / side) as i32,
         ));
         o = choice;
-        value = value.zip(grid.values[(t - 1) * n + o]).map(|(a, v)| a + v);
     }
-    BestPath {
-        moves,
-        value: value.unwrap_or(f64::NEG_INFINITY),
-    }
+    moves
 }
 
 /// One layer of [`best_path`]'s programme for an open motion of speed `M`
-/// (every offset free): `cur[o] = vals[o] + max of next over the (2M+1)²
-/// square around o` for `o` in the box `lo..=hi` × `lo..=hi` of step t. The
-/// successors are that whole square, so their maximum is separable: maxima
-/// along rows into `rowmax`, then along columns. `hi + M` is inside the
-/// square of offsets (t < T), and `f64::max` is associative and commutative
-/// up to the sign of zeros, so `best` compares exactly as the successor
-/// lists' fold would.
-fn open_layer<const M: usize>(
+/// (every offset free): `cur[o] = score(o) + max of next over the (2M+1)²
+/// square around o` for `o` in the box `lo..=hi` × `lo..=hi` of step t
+/// (scores at flat index `base + o`). The successors are that whole square,
+/// so their maximum is separable: maxima along rows into `rowmax`, then
+/// along columns. `hi + M` is inside the square of offsets (t < T), and the
+/// maximum is associative and commutative (up to the sign of zeros), so
+/// `best` compares exactly as the successor lists' fold would.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn open_layer<const M: usize, S: Score>(
+    grid: &ValueGrid,
+    base: usize,
     side: usize,
     lo: usize,
     hi: usize,
-    vals: &[Option<f64>],
-    next: &[f64],
-    rowmax: &mut [f64],
-    cur: &mut [f64],
+    next: &[S],
+    rowmax: &mut [S],
+    cur: &mut [S],
 ) {
     for r in lo - M..=hi + M {
         let row = r * side;
@@ -631,44 +806,42 @@ fn open_layer<const M: usize>(
             .iter_mut()
             .zip(src.windows(2 * M + 1))
         {
-            *dst = w.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b));
+            *dst = w.iter().fold(S::NONE, |a, &b| a.max(b));
         }
     }
     for r in lo..=hi {
         let row = r * side;
         for o in row + lo..=row + hi {
-            let Some(v) = vals[o] else { continue };
-            let f = (0..=2 * M).fold(f64::NEG_INFINITY, |a, i| {
-                a.max(rowmax[o + i * side - M * side])
-            });
-            cur[o] = v + f;
+            let Some(v) = S::at(grid, base + o) else {
+                continue;
+            };
+            let f = (0..=2 * M).fold(S::NONE, |a, i| a.max(rowmax[o + i * side - M * side]));
+            cur[o] = v.add(f);
         }
     }
 }
 
 /// Exhaustive enumeration of the displacement sequences in
 /// [`step_displacements`] order (legal ones only: an illegal prefix is not
-/// extended), keeping the first strictly better one: the paper's search, as
-/// a reference for tests and benches. Its cost grows as `(2m+1)^(2T)`.
+/// extended), keeping the first strictly better one (by value, or by
+/// (violations, −value) when the grid has violation counts): the paper's
+/// search, as a reference for tests and benches. Its cost grows as
+/// `(2m+1)^(2T)`.
 pub fn brute_force(grid: &ValueGrid) -> BestPath {
     let h = grid.horizon();
-    let mut best = BestPath {
-        moves: vec![(0, 0); h],
-        value: f64::NEG_INFINITY,
-    };
+    let mut best = (vec![(0, 0); h], Lex::NONE);
     let mut moves = Vec::with_capacity(h);
     fn go(
         grid: &ValueGrid,
         o: usize,
-        total: f64,
+        total: Lex,
         moves: &mut Vec<(i32, i32)>,
-        best: &mut BestPath,
+        best: &mut (Vec<(i32, i32)>, Lex),
     ) {
         let t = moves.len();
         if t == grid.horizon() {
-            if total > best.value {
-                best.value = total;
-                best.moves = moves.clone();
+            if total.better(best.1) {
+                *best = (moves.clone(), total);
             }
             return;
         }
@@ -677,16 +850,35 @@ pub fn brute_force(grid: &ValueGrid) -> BestPath {
             let Some(o2) = grid.motion.step(o, d) else {
                 continue;
             };
-            let Some(v) = grid.values[t * n + o2] else {
+            let Some(value) = grid.values[t * n + o2] else {
                 continue;
             };
+            let violations = grid.violations.get(t * n + o2).copied().unwrap_or(0);
+            let here = Lex {
+                neg_violations: -f64::from(violations),
+                value,
+            };
             moves.push(d);
-            go(grid, o2, total + v, moves, best);
+            go(grid, o2, total.add(here), moves, best);
             moves.pop();
         }
     }
-    go(grid, grid.motion.start(), 0.0, &mut moves, &mut best);
-    best
+    let zero = Lex {
+        neg_violations: 0.0,
+        value: 0.0,
+    };
+    go(grid, grid.motion.start(), zero, &mut moves, &mut best);
+    let (moves, score) = best;
+    let found = score.value > f64::NEG_INFINITY;
+    BestPath {
+        moves,
+        value: score.value,
+        violations: if found {
+            -score.neg_violations as u32
+        } else {
+            0
+        },
+    }
 }
 
 #[cfg(test)]

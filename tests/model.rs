@@ -674,6 +674,7 @@ fn mixture_spec(fov: FovSpec) -> ScenarioSpec {
             },
         ],
         horizon: Some(3.into()),
+        min_separation: None,
     }
 }
 

@@ -188,6 +188,7 @@ pub fn lattice(side: usize) -> Scenario {
             src(2.0 * w / 3.0, w + 1.0),
         ],
         horizon: Some(3.into()),
+        min_separation: None,
     })
     .unwrap()
 }

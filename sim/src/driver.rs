@@ -386,6 +386,7 @@ impl Sim {
             coordination: settings.map(|p| p.coordination),
             observed: settings.map(|p| p.observed),
             explain: None,
+            min_separation: None,
         }
     }
 

@@ -219,6 +219,10 @@ macro_rules! plan_request_with {
             pub observed: Option<Observed>,
             /// Include the search values in the response.
             pub explain: Option<bool>,
+            /// Minimum separation between sensors at every step, cells
+            /// (0..=16, 0 = no rule); the scenario's by default.
+            #[schema(value_type = Option<u32>, minimum = 0, maximum = 16)]
+            pub min_separation: Option<Integer>,
         }
     };
 }

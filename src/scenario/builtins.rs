@@ -40,6 +40,7 @@ pub fn paper_spec(target_speed: f64) -> ScenarioSpec {
             src(200.0, 301.0),
         ],
         horizon: Some(3.into()),
+        min_separation: None,
     }
 }
 
@@ -103,6 +104,7 @@ pub fn site_gates_spec() -> ScenarioSpec {
             },
         ],
         horizon: Some(3.into()),
+        min_separation: None,
     }
 }
 

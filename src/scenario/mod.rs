@@ -149,6 +149,13 @@ pub struct ScenarioSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(value_type = Option<u32>, minimum = 1, maximum = 12)]
     pub horizon: Option<Integer>,
+    /// Minimum separation between sensors, cells (0..=16, default 0: no
+    /// rule): at every step of a plan any two sensors stand at Chebyshev
+    /// distance ≥ this many cells wherever that can be kept (1: never on
+    /// one cell). A plan request may override it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<u32>, minimum = 0, maximum = 16)]
+    pub min_separation: Option<Integer>,
 }
 
 /// A lattice cell, `col` east and `row` north.
@@ -194,6 +201,8 @@ pub struct Scenario {
     class_offsets: Vec<usize>,
     /// Default horizon.
     pub horizon: usize,
+    /// Default minimum separation between sensors, cells (0: none).
+    pub min_separation: usize,
 }
 
 fn finite_positive(field: &str, v: f64) -> Result<f64, ValidationError> {
@@ -272,6 +281,16 @@ pub fn check_horizon(
     default: usize,
 ) -> Result<usize, ValidationError> {
     h.map_or(Ok(default), |h| h.check(field, 1..=MAX_HORIZON))
+}
+
+/// Checks a minimum separation against
+/// `0..=`[`crate::separation::MAX_MIN_SEPARATION`]; `None` stays `None`.
+pub fn check_min_separation(
+    field: &str,
+    d: Option<&Integer>,
+) -> Result<Option<usize>, ValidationError> {
+    d.map(|d| d.check(field, 0..=crate::separation::MAX_MIN_SEPARATION))
+        .transpose()
 }
 
 impl Scenario {
@@ -382,7 +401,11 @@ impl Scenario {
             ));
         }
         let horizon = check_horizon("horizon", spec.horizon.as_ref(), DEFAULT_HORIZON)?;
+        let min_separation =
+            check_min_separation("min_separation", spec.min_separation.as_ref())?.unwrap_or(0);
         let canonical = ScenarioSpec {
+            // 0 is the default: dropped, so specs keep the ids they had.
+            min_separation: (min_separation > 0).then(|| min_separation.into()),
             sources: canonical_sources,
             horizon: Some(horizon.into()),
             sensor_speed: fleet.sensor_speed,
@@ -411,6 +434,7 @@ impl Scenario {
             classes,
             class_offsets,
             horizon,
+            min_separation,
         })
     }
 

@@ -207,7 +207,8 @@ fn new_is_speed_one_all_free() {
         best_path(&g),
         BestPath {
             moves: vec![],
-            value: 0.0
+            value: 0.0,
+            violations: 0
         }
     );
 }
@@ -301,7 +302,8 @@ fn speed_two_goes_around_a_single_block() {
         best_path(&g),
         BestPath {
             moves: vec![(0, 0)],
-            value: 3.0
+            value: 3.0,
+            violations: 0
         }
     );
     assert_eq!(g.path_value(&[(1, 0)]), None);
