@@ -166,7 +166,9 @@ pub struct PlanRequest {
     pub explain: Option<bool>,
     /// Minimum separation between sensors at every step of the plan,
     /// cells (Chebyshev distance; 0..=16, 0 = no rule); the scenario's by
-    /// default.
+    /// default. Kept wherever it can be: a sensor that cannot keep it (it
+    /// starts too close to another, or is cornered) takes the path with the
+    /// fewest violations, which the response counts.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(value_type = Option<u32>, minimum = 0, maximum = 16)]
     pub min_separation: Option<Integer>,

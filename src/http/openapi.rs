@@ -220,7 +220,10 @@ macro_rules! plan_request_with {
             /// Include the search values in the response.
             pub explain: Option<bool>,
             /// Minimum separation between sensors at every step, cells
-            /// (0..=16, 0 = no rule); the scenario's by default.
+            /// (Chebyshev distance; 0..=16, 0 = no rule); the scenario's by
+            /// default. Kept wherever it can be: a sensor that cannot keep
+            /// it takes the path with the fewest violations, which the
+            /// response counts.
             #[schema(value_type = Option<u32>, minimum = 0, maximum = 16)]
             pub min_separation: Option<Integer>,
         }
@@ -551,6 +554,19 @@ pub mod examples {
         })
     }
 
+    /// Two sensors on one cell and a third, kept 3 cells apart at every
+    /// step.
+    pub fn plan_request_apart() -> Value {
+        json!({
+            "sensors": [
+                {"id": "a", "x": 150.0, "y": 150.0},
+                {"id": "b", "x": 155.0, "y": 155.0},
+                {"id": "c", "x": 175.0, "y": 150.0}
+            ],
+            "min_separation": 3
+        })
+    }
+
     /// [`plan_request`] for `POST /v1/plan`, naming the scenario.
     pub fn plan_request_by_id() -> Value {
         let mut req = plan_request();
@@ -584,27 +600,32 @@ pub mod examples {
             "horizon": 3,
             "estimator": "exact",
             "coordination": "priority",
+            "min_separation": 0,
+            "separation_violations": 0,
             "plans": [
                 {
                     "sensor": "a",
                     "priority": 1,
                     "start": cell(5, 5),
                     "path": [cell(6, 4), cell(7, 3), cell(8, 2)],
-                    "expected_detections": 6.9032
+                    "expected_detections": 6.9032,
+                    "separation_violations": 0
                 },
                 {
                     "sensor": 7,
                     "priority": 3,
                     "start": cell(15, 15),
                     "path": [cell(14, 16), cell(13, 17), cell(12, 18)],
-                    "expected_detections": 5.8559
+                    "expected_detections": 5.8559,
+                    "separation_violations": 0
                 },
                 {
                     "sensor": "c",
                     "priority": 2,
                     "start": cell(24, 6),
                     "path": [cell(23, 5), cell(22, 4), cell(22, 3)],
-                    "expected_detections": 6.3405
+                    "expected_detections": 6.3405,
+                    "separation_violations": 0
                 }
             ],
             "expected_detections": 19.0996,

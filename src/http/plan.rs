@@ -31,6 +31,8 @@ use crate::scenario::{Scenario, ScenarioSpec};
                 value = json!(examples::plan_request()))),
             ("minimal" = (summary = "One sensor, no targets, every option by default",
                 value = json!({"sensors": [{"id": "a", "x": 150.0, "y": 150.0}]}))),
+            ("apart" = (summary = "Sensors kept at least 3 cells apart at every step",
+                value = json!(examples::plan_request_apart()))),
         )),
     responses(
         (status = 200, description = "One plan per sensor, in request order.", body = PlanResponse,

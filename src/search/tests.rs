@@ -354,3 +354,111 @@ fn to_nested_is_side_squared_with_nulls() {
     assert!(nested[0][4][4 + 3].is_none());
     assert!(nested[1][4 + 4][4 + 4].is_some());
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(96))]
+
+    /// With violation counts, DP = brute force on (violations, −value) in
+    /// lexicographic order, for every speed, blocked cells and open
+    /// lattices (the separable maxima); and the optimum is checked against
+    /// an enumeration of the tests' own over every legal path.
+    #[test]
+    fn lexicographic_dp_equals_brute_force_and_enumeration(
+        speed in 1usize..=3,
+        horizon in 1usize..=3,
+        cells in prop::collection::vec(0u8..10, 1..400),
+        density in 0u8..5,
+        vals in prop::collection::vec(0u8..4, 1..200),
+        boxes in prop::collection::vec((1usize..=3, -9i32..=9, -9i32..=9, 0i32..=2), 0..6),
+    ) {
+        let free = mask(speed, horizon, &cells, density);
+        let e = (speed * horizon) as i32;
+        let mut g = ValueGrid::with_motion(horizon, speed, &free);
+        let mut i = 0;
+        for t in 1..=horizon {
+            let mut seen = Vec::new();
+            g.for_each_reachable(t, |dc, dr| seen.push((dc, dr)));
+            for (dc, dr) in seen {
+                g.set(t, dc, dr, f64::from(vals[i % vals.len()]));
+                i += 1;
+            }
+        }
+        // Another sensor's cell at step t, with a square of radius r
+        // around it too close.
+        let mut counts = std::collections::HashMap::new();
+        for &(t, c, r, rad) in &boxes {
+            if t > horizon {
+                continue;
+            }
+            g.add_violations(t, c - rad..=c + rad, r - rad..=r + rad);
+            for dr in r - rad..=r + rad {
+                for dc in c - rad..=c + rad {
+                    *counts.entry((t, dc, dr)).or_insert(0u32) += 1;
+                }
+            }
+        }
+        for t in 1..=horizon {
+            for dr in -e..=e {
+                for dc in -e..=e {
+                    let want = counts.get(&(t, dc, dr)).copied().unwrap_or(0);
+                    prop_assert_eq!(g.violations(t, dc, dr), want);
+                }
+            }
+        }
+        let dp = best_path(&g);
+        let bf = brute_force(&g);
+        prop_assert_eq!(dp.value, bf.value);
+        prop_assert_eq!(dp.violations, bf.violations);
+        prop_assert_eq!(&dp.moves, &bf.moves);
+        prop_assert_eq!(g.path_violations(&dp.moves), Some(dp.violations));
+        // Every legal path by the tests' own enumeration (steps from the
+        // independent breadth-first search): none is lexicographically
+        // better.
+        fn all_paths(
+            free: &dyn Fn(i32, i32) -> bool, e: i32, speed: usize, h: usize,
+            at: (i32, i32), path: &mut Vec<(i32, i32)>, out: &mut Vec<Vec<(i32, i32)>>,
+        ) {
+            if path.len() == h {
+                out.push(path.clone());
+                return;
+            }
+            for p in one_step(free, e, at, speed) {
+                path.push(p);
+                all_paths(free, e, speed, h, p, path, out);
+                path.pop();
+            }
+        }
+        let mut paths = Vec::new();
+        all_paths(&free, e, speed, horizon, (0, 0), &mut Vec::new(), &mut paths);
+        let score = |p: &[(i32, i32)]| {
+            let mut v = 0.0;
+            let mut k = 0u32;
+            for (t, &(dc, dr)) in p.iter().enumerate() {
+                v += g.get(t + 1, dc, dr).expect("every reachable cell has a value");
+                k += counts.get(&(t + 1, dc, dr)).copied().unwrap_or(0);
+            }
+            (k, v)
+        };
+        let best = paths.iter().map(|p| score(p)).min_by(|a, b| {
+            a.0.cmp(&b.0).then(b.1.total_cmp(&a.1))
+        });
+        prop_assert_eq!(best, Some((dp.violations, dp.value)));
+        prop_assert_eq!(score(&dp.offsets()), (dp.violations, dp.value));
+    }
+}
+
+#[test]
+fn violations_are_clipped_and_cleared() {
+    let mut g = ValueGrid::new(2);
+    g.add_violations(1, -5..=-1, 0..=9);
+    g.add_violations(3, -1..=1, -1..=1); // beyond the horizon: ignored
+    assert!(g.has_violations());
+    assert_eq!(g.violations(1, -1, 0), 1);
+    assert_eq!(g.violations(1, -2, 2), 1);
+    assert_eq!(g.violations(1, 0, 0), 0);
+    assert_eq!(g.violations(2, -1, 0), 0);
+    assert_eq!(g.violations(1, -1, -1), 0);
+    g.clear_violations();
+    assert!(!g.has_violations());
+    assert_eq!(g.violations(1, -1, 0), 0);
+}

@@ -11,3 +11,4 @@ mod openapi;
 mod ops;
 mod plan;
 mod scenarios;
+mod separation;

@@ -531,6 +531,7 @@ fn every_routed_path_is_documented() {
 fn schema_bounds_are_the_code_limits() {
     use vigil::planner::{MAX_HISTORY_POSITIONS, MAX_HISTORY_STEPS, MAX_SENSORS, MAX_TARGETS};
     use vigil::scenario::{MAX_HORIZON, MAX_SOURCES, MAX_SPEED_CLASSES};
+    use vigil::separation::MAX_MIN_SEPARATION;
     let doc = document();
     let schemas = &doc["components"]["schemas"];
     for request in ["PlanRequest", "PlanRequestById", "PlanRequestWithScenario"] {
@@ -546,11 +547,17 @@ fn schema_bounds_are_the_code_limits() {
         assert_eq!(p["horizon"]["maximum"], MAX_HORIZON, "{request}");
         assert_eq!(p["horizon"]["minimum"], 1, "{request}");
         assert_eq!(p["horizon"]["type"], serde_json::json!(["integer", "null"]));
+        assert_eq!(
+            p["min_separation"]["maximum"], MAX_MIN_SEPARATION,
+            "{request}"
+        );
+        assert_eq!(p["min_separation"]["minimum"], 0, "{request}");
     }
     let spec = &schemas["ScenarioSpec"]["properties"];
     assert_eq!(spec["sources"]["maxItems"], MAX_SOURCES);
     assert_eq!(spec["sources"]["minItems"], 1);
     assert_eq!(spec["horizon"]["maximum"], MAX_HORIZON);
+    assert_eq!(spec["min_separation"]["maximum"], MAX_MIN_SEPARATION);
     let source = &schemas["SourceSpec"]["properties"];
     assert_eq!(source["speeds"]["maxItems"], MAX_SPEED_CLASSES);
     assert_eq!(source["spread"]["maximum"], 180);
