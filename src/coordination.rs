@@ -24,8 +24,18 @@
 //! keeps the sensors apart: paths are fixed in rank order, and each sensor
 //! after the first searches with the fixed paths' cells marked as
 //! violations, minimising (violations, −value) lexicographically. `None`
-//! still ignores the others' values, but not their positions. In
-//! `Iterated` a sensor's search counts violations against every other
+//! still ignores the others' values, but not their positions.
+//!
+//! That pass never revisits a higher-ranked sensor, which may corner a
+//! lower one (push it against the zone's edge, say) although it could
+//! have stood back. So while some pair is too close, a repair round (at
+//! most [`MAX_REPAIRS`]) takes the highest-ranked sensor in a violation
+//! whose search around *every* other path has fewer violations than its
+//! own, gives it that path, lets the ranks below it plan again in order,
+//! and keeps the result if fewer pairs are too close in all. The last
+//! sensor still plans last, around the others' final paths.
+//!
+//! In `Iterated` a sensor's search counts violations against every other
 //! sensor's current path, and a new path is taken when it has fewer
 //! violations, or as many and more value, so each change lowers the
 //! number of pairs too close or keeps it and raises the total.
@@ -56,6 +66,9 @@ pub enum Coordination {
 /// Largest number of best-response rounds in `Iterated`.
 pub const MAX_ROUNDS: usize = 10;
 
+/// Largest number of repair rounds of the separation.
+pub const MAX_REPAIRS: usize = 8;
+
 /// One sensor's plan.
 #[derive(Debug, Clone)]
 pub struct SensorPlan {
@@ -81,6 +94,8 @@ pub struct Coordinated {
     pub by_step: Vec<f64>,
     /// Best-response rounds run (iterated only).
     pub rounds: usize,
+    /// Repair rounds of the separation run (see the module docs).
+    pub repairs: usize,
     /// Breaches of the minimum separation among the final paths.
     pub violations: Violations,
 }
@@ -139,33 +154,80 @@ pub fn coordinate(
     let mut order: Vec<usize> = (0..n).collect();
     // Stable sort: ties keep request order.
     order.sort_by(|&a, &b| plans[b].value.total_cmp(&plans[a].value));
-    let mut rounds = 0;
-    if mode != Coordination::None {
-        // Priority: each sensor against the ones above it, in rank order.
-        for rank in 1..order.len() {
-            let i = order[rank];
-            let above = &order[..rank];
-            let plan = {
-                let looks = looks_by_step(s, &plans, types, above, horizon, i, starts[i]);
-                let avoid = paths(&plans, &mut above.iter().copied());
-                plan_one(
-                    i,
-                    &mut |t, g| est.fill(i, starts[i], t, &looks[t - 1], g),
-                    avoid.iter().map(Vec::as_slice).collect(),
-                )
-            };
-            plans[i] = plan;
+    // Without coordination but apart, each sensor keeps its lone values.
+    let alone: Vec<ValueGrid> = if mode == Coordination::None && d > 0 {
+        plans.iter().map(|p| p.grid.clone()).collect()
+    } else {
+        Vec::new()
+    };
+    // The priority pass's search of the sensor ranked `rank`: its values
+    // against the sensors ranked above it (its lone values without
+    // coordination), around the paths of those sensors, or of every other
+    // sensor when `around_all`.
+    let ranked = |plans: &[SensorPlan], rank: usize, around_all: bool| -> SensorPlan {
+        let i = order[rank];
+        let above = &order[..rank];
+        let avoid = if around_all {
+            paths(plans, &mut (0..n).filter(|&j| j != i))
+        } else {
+            paths(plans, &mut above.iter().copied())
+        };
+        let avoid = avoid.iter().map(Vec::as_slice).collect();
+        if mode == Coordination::None {
+            let mut grid = alone[i].clone();
+            mark_too_close(&mut grid, starts[i], d, avoid);
+            search(grid, starts[i])
+        } else {
+            let looks = looks_by_step(s, plans, types, above, horizon, i, starts[i]);
+            plan_one(
+                i,
+                &mut |t, g| est.fill(i, starts[i], t, &looks[t - 1], g),
+                avoid,
+            )
         }
-    } else if d > 0 {
-        // No coordination, but apart: each sensor keeps its own values and
-        // plans around the positions of the ones above it.
-        for rank in 1..order.len() {
-            let i = order[rank];
-            let avoid = paths(&plans, &mut order[..rank].iter().copied());
-            let mut grid = std::mem::replace(&mut plans[i].grid, motions[i].clone());
-            grid.clear_violations();
-            mark_too_close(&mut grid, starts[i], d, avoid.iter().map(Vec::as_slice));
-            plans[i] = search(grid, starts[i]);
+    };
+    let mut rounds = 0;
+    let mut repairs = 0;
+    if mode != Coordination::None || d > 0 {
+        // Priority: each sensor against the ones above it, in rank order.
+        for rank in 1..n {
+            plans[order[rank]] = ranked(&plans, rank, false);
+        }
+    }
+    if d > 0 {
+        // Repair: a higher-ranked sensor may have cornered a lower one,
+        // which the pass above never revisits. The highest-ranked sensor
+        // too close to another that can have fewer violations against every
+        // other path takes that path, the ranks below it plan again in
+        // order, and the change stays if fewer pairs are too close.
+        let mut total = separation::count(&all_paths(&plans), d);
+        while total.pairs > 0 && repairs < MAX_REPAIRS {
+            repairs += 1;
+            let mut improved = false;
+            for rank in 0..n {
+                let i = order[rank];
+                if total.per_sensor[i] == 0 {
+                    continue;
+                }
+                let candidate = ranked(&plans, rank, true);
+                if candidate.violations >= total.per_sensor[i] {
+                    continue;
+                }
+                let mut trial = plans.clone();
+                trial[i] = candidate;
+                for below in rank + 1..n {
+                    trial[order[below]] = ranked(&trial, below, false);
+                }
+                let after = separation::count(&all_paths(&trial), d);
+                if after.pairs < total.pairs {
+                    (plans, total) = (trial, after);
+                    improved = true;
+                    break;
+                }
+            }
+            if !improved {
+                break;
+            }
         }
     }
     if mode == Coordination::Iterated {
@@ -240,15 +302,19 @@ pub fn coordinate(
                 .sum()
         })
         .collect();
-    let violations =
-        separation::count(&plans.iter().map(|p| p.path.clone()).collect::<Vec<_>>(), d);
+    let violations = separation::count(&all_paths(&plans), d);
     Coordinated {
         plans,
         order,
         by_step,
         rounds,
+        repairs,
         violations,
     }
+}
+
+fn all_paths(plans: &[SensorPlan]) -> Vec<Vec<Cell>> {
+    plans.iter().map(|p| p.path.clone()).collect()
 }
 
 /// For the paper estimator, whose total depends on rank order: the change

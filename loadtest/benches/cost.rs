@@ -4,7 +4,7 @@
 //! (`paper-v10`, 10 sensors, 16 steps of history, the targets they track,
 //! exact + priority, T = 3), and scenario precompute time against lattice
 //! size; and plan time on `site-gates` against the number of speed classes
-//! per source.
+//! per source; and plan time against the minimum separation.
 //!
 //! Every request comes from a `vigil-sim` run ([`Workload`]); before timing,
 //! each answer is checked (one path of T legal moves per sensor). The
@@ -280,9 +280,30 @@ fn fleets(c: &mut Criterion) {
     g.finish();
 }
 
+/// `plan_separation/D`: the reference workload's requests (T = 3) with
+/// a minimum separation of D cells: 0 (no rule, the reference itself), 1
+/// (never on one cell) and 3.
+fn separation(c: &mut Criterion) {
+    let planner = Planner::new(builtins().remove(0));
+    let base = Workload::reference().requests(&planner, 4);
+    let mut g = group(c, "plan_separation");
+    for d in [0, 1, 3] {
+        let reqs: Vec<PlanRequest> = base
+            .iter()
+            .map(|r| PlanRequest {
+                min_separation: Some(d.into()),
+                ..r.clone()
+            })
+            .collect();
+        bench_requests(&mut g, &planner, d, &reqs);
+    }
+    g.finish();
+}
+
 criterion_group!(
     benches,
     horizon,
+    separation,
     sensors,
     targets,
     history,

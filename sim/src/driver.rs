@@ -9,6 +9,11 @@
 //! `p_detect`; those Bernoulli draws come from a third stream of their own
 //! (and are skipped when `p_detect` is 1), so they never disturb the
 //! targets either.
+//!
+//! A minimum separation ([`Sim::min_separation`], the scenario's by
+//! default) keeps the sensors apart: planner policies send it with every
+//! plan request, and the local policies' moves go through
+//! [`keep_apart`].
 
 use std::collections::{HashMap, HashSet, VecDeque};
 
@@ -19,7 +24,7 @@ use vigil::scenario::{Cell, Scenario};
 use vigil::world::World;
 
 use crate::metrics::StepCount;
-use crate::policy::{Policy, legal_moves, local_force_move, random_move};
+use crate::policy::{Policy, keep_apart, legal_moves, local_force_move, random_move};
 
 /// Where the sensors start.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -170,6 +175,10 @@ pub struct Sim {
     window_start: Option<usize>,
     /// Each sensor's cell after every step, for pictures.
     pub trace: Vec<Vec<Cell>>,
+    /// Minimum separation between sensors, cells; `None`: the scenario's.
+    /// Sent with plan requests when set, and kept by the local policies
+    /// ([`Sim::local_moves`]).
+    pub min_separation: Option<usize>,
 }
 
 impl Sim {
@@ -237,6 +246,7 @@ impl Sim {
             detected: HashSet::new(),
             in_zone_before: HashSet::new(),
             window_start: None,
+            min_separation: None,
         }
     }
 
@@ -386,8 +396,16 @@ impl Sim {
             coordination: settings.map(|p| p.coordination),
             observed: settings.map(|p| p.observed),
             explain: None,
-            min_separation: None,
+            // Only when set: requests otherwise stay as they were, and the
+            // server applies the scenario's.
+            min_separation: self.min_separation.map(Into::into),
         }
+    }
+
+    /// The minimum separation in force, cells: [`Sim::min_separation`] or
+    /// else the scenario's (0: no rule).
+    pub fn separation(&self) -> usize {
+        self.min_separation.unwrap_or(self.scenario.min_separation)
     }
 
     /// The name of sensor `i`'s type for a request; `None` for `default`
@@ -397,8 +415,25 @@ impl Sim {
         (ty != 0).then(|| self.scenario.types[ty].name.clone())
     }
 
-    /// Next cells of a local policy.
+    /// Next cells of a local policy: each sensor's intended move, then
+    /// the minimum separation ([`Sim::separation`]) applied by
+    /// [`keep_apart`] (with none, the intended moves unchanged). A
+    /// stationary sensor intends to stay, so it moves only to get clear of
+    /// a sensor before it.
     pub fn local_moves(&mut self, policy: Policy) -> Vec<Cell> {
+        let intended = self.intended_moves(policy);
+        keep_apart(
+            &self.scenario,
+            &self.sensors,
+            &intended,
+            &self.types,
+            self.separation(),
+        )
+    }
+
+    /// What each sensor of a local policy would do alone: the random
+    /// policy's draws, the local force law's moves, or staying.
+    fn intended_moves(&mut self, policy: Policy) -> Vec<Cell> {
         let s = &self.scenario;
         match policy {
             Policy::Random => {
@@ -465,15 +500,20 @@ impl Sim {
         self.step += 1;
         self.sense();
         let detections = self.detections();
+        let mut occupied = self.sensors.clone();
+        occupied.sort_unstable();
+        occupied.dedup();
         let mut count = StepCount {
             in_zone: detections.len(),
+            cells: occupied.len(),
             ..StepCount::default()
         };
         for &(id, _, n) in &detections {
             if n > 0 {
                 count.detected += 1;
-                if let Some(slot) = count.by_exactly.get_mut(n - 1) {
-                    *slot += 1;
+                match count.by_exactly.get_mut(n - 1) {
+                    Some(slot) => *slot += 1,
+                    None => count.four_plus += 1,
                 }
             }
             if self.window_start.is_some() && !self.in_zone_before.contains(&id) {

@@ -41,6 +41,11 @@ pub struct RunConfig {
     pub history: usize,
     /// Sensors' starting positions.
     pub start: Start,
+    /// Minimum separation between sensors, cells (0..=16); `None`: the
+    /// scenario's. Planner policies send it with each plan request (only
+    /// when set); the local policies keep it through
+    /// [`crate::policy::keep_apart`].
+    pub min_separation: Option<usize>,
 }
 
 impl RunConfig {
@@ -55,6 +60,7 @@ impl RunConfig {
             seed,
             self.history,
         );
+        sim.min_separation = self.min_separation;
         for _ in 0..self.warmup {
             sim.observe();
             let stay = sim.sensors.clone();
@@ -66,6 +72,12 @@ impl RunConfig {
 }
 
 impl RunConfig {
+    /// The minimum separation in force, cells: this configuration's or the
+    /// scenario's.
+    pub fn separation(&self) -> usize {
+        self.min_separation.unwrap_or(self.scenario.min_separation)
+    }
+
     /// Each sensor's type. A fleet that does not fit the scenario (which
     /// [`fleet_types`] reports before runs start) falls back to `default`.
     pub fn types(&self) -> Vec<usize> {
@@ -101,6 +113,10 @@ pub async fn run_one(
             let req = sim.plan_request(cfg.policy, cfg.horizon);
             let (resp, ms) = client.plan(&cfg.scenario_id, &req).await?;
             acc.add_plan_time(ms);
+            acc.add_plan_violations(
+                resp.separation_violations,
+                resp.plans.iter().map(|p| p.separation_violations),
+            );
             let next = sim.moves_from_plan(&resp).map_err(RunError::Contract)?;
             (next, resp.expected_by_step.first().copied())
         } else {
@@ -134,6 +150,8 @@ pub struct Row {
     pub target_speed: Option<f64>,
     /// Measured steps per run.
     pub steps: usize,
+    /// Minimum separation in force, cells (0: none).
+    pub min_separation: usize,
     /// Seeds averaged.
     pub seeds: usize,
     /// Means over seeds.
@@ -200,6 +218,7 @@ pub async fn run_all(
                 fleet: cfg.fleet.clone(),
                 target_speed: cfg.scenario.single_speed(),
                 steps: cfg.steps,
+                min_separation: cfg.separation(),
                 seeds: runs.len(),
                 metrics,
                 ci95,

@@ -310,6 +310,8 @@ struct Init {
     steps: usize,
     warmup: usize,
     horizon: usize,
+    /// Minimum separation in force, cells (0: none).
+    min_separation: usize,
     width: f64,
     height: f64,
     cell_size: f64,
@@ -367,6 +369,7 @@ impl Init {
             steps: opts.run.steps,
             warmup: opts.run.warmup,
             horizon: opts.run.horizon.unwrap_or(s.horizon),
+            min_separation: opts.run.separation(),
             width: s.width,
             height: s.height,
             cell_size: s.cell_size,
@@ -447,6 +450,13 @@ struct MetricsOut {
     calibration: Option<f64>,
     plan_ms: Option<f64>,
     plan_ms_mean: Option<f64>,
+    /// Distinct cells the sensors occupy now, and its mean over the run.
+    cells: usize,
+    cells_mean: f64,
+    /// The last plan's `separation_violations` (planner policies).
+    violations: Option<u32>,
+    /// The fraction of the run's plans with any (planner policies).
+    violating_plans: Option<f64>,
 }
 
 /// The metrics after every measured step, for the charts.
@@ -470,6 +480,8 @@ struct Running {
     realized: f64,
     plan_ms: f64,
     plans: usize,
+    cells: f64,
+    plans_violating: usize,
 }
 
 fn status_code(s: TargetStatus) -> u8 {
@@ -627,6 +639,7 @@ async fn drive(shared: Arc<Shared>, client: Client, opts: LiveOptions) -> Result
         sim.observe();
         let mut plan_ms = None;
         let mut predicted = None;
+        let mut violations = None;
         let next = if cfg.policy.planner().is_some() {
             let mut req = sim.plan_request(cfg.policy, cfg.horizon);
             req.explain = Some(true);
@@ -634,6 +647,7 @@ async fn drive(shared: Arc<Shared>, client: Client, opts: LiveOptions) -> Result
             let next = sim.moves_from_plan(&resp).map_err(RunError::Contract)?;
             plan_ms = Some(ms);
             predicted = resp.expected_by_step.first().copied();
+            violations = Some(resp.separation_violations);
             plan = Some(resp);
             next
         } else {
@@ -642,6 +656,8 @@ async fn drive(shared: Arc<Shared>, client: Client, opts: LiveOptions) -> Result
         let count = sim.advance(next);
         run.steps += 1;
         run.ad += count.detected as f64;
+        run.cells += count.cells as f64;
+        run.plans_violating += usize::from(violations.is_some_and(|v| v > 0));
         let af = (count.in_zone > 0).then(|| count.detected as f64 / count.in_zone as f64);
         if let Some(af) = af {
             run.af += af;
@@ -676,6 +692,10 @@ async fn drive(shared: Arc<Shared>, client: Client, opts: LiveOptions) -> Result
             calibration,
             plan_ms,
             plan_ms_mean: (run.plans > 0).then(|| run.plan_ms / run.plans as f64),
+            cells: count.cells,
+            cells_mean: run.cells / run.steps as f64,
+            violations,
+            violating_plans: (run.plans > 0).then(|| run.plans_violating as f64 / run.plans as f64),
         };
         publish(
             &shared,

@@ -9,6 +9,7 @@
 //! vigil-sim --scenario site-fleet --fleet drone:4,robot:6 --svg fleet.svg
 //! vigil-sim --policy exact --sensors 10 --svg run.svg
 //! vigil-sim --live --policy exact --sensors 10      # watch one run in a browser
+//! vigil-sim --experiment table1 --min-separation 3 # sensors ≥ 3 cells apart
 //! ```
 //! Without `--server` it starts a server in-process on a loopback port and
 //! still talks HTTP to it.
@@ -103,6 +104,14 @@ struct Args {
     /// Steps per second of the live view at the start (the page changes it).
     #[arg(long, default_value_t = 10.0)]
     live_speed: f64,
+    /// Minimum separation between sensors, cells (0..=16; Chebyshev
+    /// distance at every step; 0: no rule); the scenario's by default.
+    /// Planner policies send it with each plan request; the local policies
+    /// (random, local-force, stationary) keep it by moving each sensor, in
+    /// sensor order, to its intended cell, else staying, else the nearest
+    /// allowed legal move.
+    #[arg(long, value_parser = clap::value_parser!(u8).range(0..=vigil::separation::MAX_MIN_SEPARATION as i64))]
+    min_separation: Option<u8>,
 }
 
 #[tokio::main]
@@ -155,6 +164,7 @@ async fn run(args: Args) -> Result<(), String> {
         horizon: args.horizon,
         history: args.history.into(),
         start: args.start,
+        min_separation: args.min_separation.map(usize::from),
     };
     let configs = match &args.experiment {
         Some(name) => {

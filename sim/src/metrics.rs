@@ -12,6 +12,10 @@ pub struct StepCount {
     pub detected: usize,
     /// Detected by exactly one, two, three sensors.
     pub by_exactly: [usize; 3],
+    /// Detected by four or more sensors.
+    pub four_plus: usize,
+    /// Distinct cells the sensors occupy after the step's move.
+    pub cells: usize,
 }
 
 /// Accumulates the steps of one run.
@@ -23,9 +27,20 @@ pub struct RunAccumulator {
     af_sum: f64,
     af_steps: usize,
     d: [f64; 3],
+    d4: f64,
+    cells: f64,
     realized_next: f64,
     predicted_next: f64,
     plan_ms: Vec<f64>,
+    /// Plan responses counted by [`RunAccumulator::add_plan_violations`].
+    plans: usize,
+    /// Of those, the ones with a separation violation.
+    plans_violating: usize,
+    /// Σ of their `separation_violations` (pairs of sensors × steps).
+    violation_pairs: f64,
+    /// Sensor plans in those responses, and those with a violation.
+    sensor_plans: usize,
+    sensor_plans_violating: usize,
 }
 
 impl RunAccumulator {
@@ -40,6 +55,21 @@ impl RunAccumulator {
         }
         for (d, n) in self.d.iter_mut().zip(c.by_exactly) {
             *d += n as f64;
+        }
+        self.d4 += c.four_plus as f64;
+        self.cells += c.cells as f64;
+    }
+
+    /// Adds a plan response's `separation_violations`: `pairs`, the (step,
+    /// pair of sensors) at which its paths are closer than the minimum
+    /// separation, and `per_sensor`, each sensor plan's own count.
+    pub fn add_plan_violations(&mut self, pairs: u32, per_sensor: impl IntoIterator<Item = u32>) {
+        self.plans += 1;
+        self.plans_violating += usize::from(pairs > 0);
+        self.violation_pairs += f64::from(pairs);
+        for v in per_sensor {
+            self.sensor_plans += 1;
+            self.sensor_plans_violating += usize::from(v > 0);
         }
     }
 
@@ -74,11 +104,18 @@ impl RunAccumulator {
             d1s: self.d[0] / n,
             d2s: self.d[1] / n,
             d3s: self.d[2] / n,
+            d4s: self.d4 / n,
+            cells: self.cells / n,
             detected_once,
             calibration: (planner && self.predicted_next > 0.0)
                 .then(|| self.realized_next / self.predicted_next),
             plan_ms_p50: planner.then(|| pct(0.5)),
             plan_ms_p99: planner.then(|| pct(0.99)),
+            violating_plans: (self.plans > 0)
+                .then(|| self.plans_violating as f64 / self.plans as f64),
+            violations_per_plan: (self.plans > 0).then(|| self.violation_pairs / self.plans as f64),
+            violating_sensor_plans: (self.sensor_plans > 0)
+                .then(|| self.sensor_plans_violating as f64 / self.sensor_plans as f64),
         }
     }
 }
@@ -98,6 +135,11 @@ pub struct Metrics {
     pub d2s: f64,
     /// Detected by exactly three sensors.
     pub d3s: f64,
+    /// Detected by four or more sensors (`D4+S`).
+    pub d4s: f64,
+    /// Distinct cells the sensors occupy after each move: the number of
+    /// sensors when no two share a cell.
+    pub cells: f64,
     /// Fraction of the targets that entered during the measured window that
     /// were detected at least once.
     pub detected_once: f64,
@@ -110,6 +152,20 @@ pub struct Metrics {
     /// 99th percentile plan round trip, ms.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub plan_ms_p99: Option<f64>,
+    /// Planner policies: the fraction of plan responses with
+    /// `separation_violations > 0` (some pair of paths closer than the
+    /// minimum separation at some step).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub violating_plans: Option<f64>,
+    /// Planner policies: the mean of the responses'
+    /// `separation_violations` ((step, pair of sensors) too close per plan).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub violations_per_plan: Option<f64>,
+    /// Planner policies: the fraction of sensor plans (one sensor's path in
+    /// a response) closer than the minimum separation to another at some
+    /// step.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub violating_sensor_plans: Option<f64>,
 }
 
 /// Two-sided 97.5% quantile of Student's t with `df` degrees of freedom.
@@ -161,10 +217,16 @@ pub fn summarize(runs: &[Metrics]) -> (Metrics, Metrics) {
     (mean.d1s, ci.d1s) = field(runs, |m| m.d1s);
     (mean.d2s, ci.d2s) = field(runs, |m| m.d2s);
     (mean.d3s, ci.d3s) = field(runs, |m| m.d3s);
+    (mean.d4s, ci.d4s) = field(runs, |m| m.d4s);
+    (mean.cells, ci.cells) = field(runs, |m| m.cells);
     (mean.detected_once, ci.detected_once) = field(runs, |m| m.detected_once);
     (mean.calibration, ci.calibration) = opt(runs, |m| m.calibration);
     (mean.plan_ms_p50, ci.plan_ms_p50) = opt(runs, |m| m.plan_ms_p50);
     (mean.plan_ms_p99, ci.plan_ms_p99) = opt(runs, |m| m.plan_ms_p99);
+    (mean.violating_plans, ci.violating_plans) = opt(runs, |m| m.violating_plans);
+    (mean.violations_per_plan, ci.violations_per_plan) = opt(runs, |m| m.violations_per_plan);
+    (mean.violating_sensor_plans, ci.violating_sensor_plans) =
+        opt(runs, |m| m.violating_sensor_plans);
     (mean, ci)
 }
 
@@ -179,24 +241,65 @@ mod tests {
             in_zone: 10,
             detected: 4,
             by_exactly: [3, 1, 0],
+            four_plus: 0,
+            cells: 10,
         });
         acc.add(StepCount {
             in_zone: 0,
             detected: 0,
             by_exactly: [0, 0, 0],
+            four_plus: 0,
+            cells: 9,
         });
         acc.add(StepCount {
             in_zone: 5,
             detected: 5,
-            by_exactly: [2, 2, 1],
+            by_exactly: [2, 1, 1],
+            four_plus: 1,
+            cells: 5,
         });
         let m = acc.finish(0.5);
         assert_eq!(m.ad, 3.0);
         assert_eq!(m.zd, 2.0);
         // Mean of 0.4 and 1.0, skipping the empty step.
         assert!((m.af - 0.7).abs() < 1e-12);
-        assert_eq!((m.d1s, m.d2s, m.d3s), (5.0 / 3.0, 1.0, 1.0 / 3.0));
+        assert_eq!((m.d1s, m.d2s, m.d3s), (5.0 / 3.0, 2.0 / 3.0, 1.0 / 3.0));
+        assert_eq!(m.d4s, 1.0 / 3.0);
+        assert_eq!(m.cells, 8.0);
         assert_eq!(m.calibration, None);
+        // A local policy: no plans, no violation figures.
+        assert_eq!((m.violating_plans, m.violations_per_plan), (None, None));
+        assert_eq!(m.violating_sensor_plans, None);
+    }
+
+    #[test]
+    fn counts_plans_with_separation_violations() {
+        let mut acc = RunAccumulator::default();
+        // Five responses of four sensor plans each: pairs and each plan's
+        // own count (the pairs' counts, once per sensor of the pair).
+        let per_sensor = [[0, 0, 0, 0], [2, 1, 3, 0], [0; 4], [0; 4], [1, 1, 0, 0]];
+        for (pairs, per) in [0, 3, 0, 0, 1].into_iter().zip(per_sensor) {
+            acc.add_plan_time(1.0);
+            acc.add_plan_violations(pairs, per);
+        }
+        let m = acc.finish(0.0);
+        assert_eq!(m.violating_plans, Some(0.4));
+        assert_eq!(m.violations_per_plan, Some(0.8));
+        assert_eq!(m.violating_sensor_plans, Some(5.0 / 20.0));
+        let (mean, ci) = summarize(&[
+            m,
+            Metrics {
+                violating_plans: Some(0.0),
+                violations_per_plan: Some(0.0),
+                cells: 4.0,
+                d4s: 2.0,
+                ..m
+            },
+        ]);
+        assert_eq!(mean.violating_plans, Some(0.2));
+        assert_eq!(mean.violations_per_plan, Some(0.4));
+        assert!(ci.violating_plans.is_some_and(|c| c > 0.0));
+        assert_eq!((mean.cells, mean.d4s), (2.0, 1.0));
     }
 
     #[test]

@@ -9,6 +9,7 @@ use vigil::geometry::Point;
 use vigil::planner::{EstimatorKind, Observed};
 use vigil::scenario::{Cell, FovSpec, Scenario};
 use vigil::search::{MOVES, step_displacements};
+use vigil::separation::too_close;
 
 /// How the sensors move.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
@@ -141,6 +142,63 @@ pub fn legal_moves(s: &Scenario, c: Cell, speed: usize) -> Vec<Cell> {
 pub fn random_move(s: &Scenario, c: Cell, speed: usize, rng: &mut impl rand::Rng) -> Cell {
     let moves = legal_moves(s, c, speed);
     moves[rng.random_range(0..moves.len())]
+}
+
+/// The minimum separation rule for the local policies: the cells the
+/// sensors take when each intended to move from `current[i]` to
+/// `intended[i]` and no two may end the step closer than `d` cells
+/// (Chebyshev distance, [`too_close`]); `types[i]` gives sensor `i`'s
+/// speed.
+///
+/// The sensors are resolved one at a time, in sensor order, each against
+/// the cells already chosen by the sensors before it (the local policies
+/// have no ranking of their own, and a fixed order makes the outcome
+/// reproducible). Sensor `i` takes, in order of preference:
+/// 1. its intended cell, if it is not too close to any chosen cell;
+/// 2. else its current cell (it stays), if that is allowed;
+/// 3. else the allowed cell among its [`legal_moves`] nearest its intended
+///    cell (Euclidean distance between cells; ties go to the first in
+///    `legal_moves`' order);
+/// 4. else, cornered, its intended cell anyway: the rule is kept wherever
+///    it can be, never at the cost of an illegal move.
+///
+/// With `d = 0` (no rule) this is `intended` unchanged. The intents are
+/// computed (and any random draws made) before the rule applies, so the
+/// rule never changes what a policy draws.
+pub fn keep_apart(
+    s: &Scenario,
+    current: &[Cell],
+    intended: &[Cell],
+    types: &[usize],
+    d: usize,
+) -> Vec<Cell> {
+    if d == 0 {
+        return intended.to_vec();
+    }
+    let mut chosen: Vec<Cell> = Vec::with_capacity(intended.len());
+    for ((&here, &want), &ty) in current.iter().zip(intended).zip(types) {
+        let allowed = |c: Cell| !chosen.iter().any(|&o| too_close(c, o, d));
+        let cell = if allowed(want) {
+            want
+        } else if allowed(here) {
+            here
+        } else {
+            // Squared distances in cells are exact integers: no float ties.
+            let dist2 = |c: Cell| {
+                let (dc, dr) = ((c.col - want.col) as i64, (c.row - want.row) as i64);
+                dc * dc + dr * dr
+            };
+            let mut best: Option<(i64, Cell)> = None;
+            for c in legal_moves(s, here, s.types[ty].speed) {
+                if allowed(c) && best.is_none_or(|(b, _)| dist2(c) < b) {
+                    best = Some((dist2(c), c));
+                }
+            }
+            best.map_or(want, |(_, c)| c)
+        };
+        chosen.push(cell);
+    }
+    chosen
 }
 
 /// Constants of the local force law.

@@ -17,16 +17,21 @@ fn opt(mean: Option<f64>, ci: Option<f64>, decimals: usize) -> String {
     }
 }
 
-/// The rows as a table: the paper's columns (EN NS AD ZD AF D1S D2S D3S TV),
-/// then ours (policy, detected once, calibration, plan round trip p50/p99);
-/// NS shows the fleet (`drone:4,robot:6`) when the sensors have types,
-/// each mean ± the half-width of its 95% confidence interval over seeds.
+/// The rows as a table: the paper's columns (EN NS AD ZD AF D1S D2S D3S,
+/// then D4+S, detected by four or more sensors, TV), then ours (policy,
+/// detected once, calibration, plan round trip p50/p99, distinct cells
+/// occupied by the sensors, `viol%`: the percentage of plan responses with
+/// a separation violation, and `sviol%`: the percentage of sensor plans
+/// with one, `-` for local policies); NS shows the fleet
+/// (`drone:4,robot:6`) when the sensors have types, each mean ± the
+/// half-width of its 95% confidence interval over seeds.
 pub fn table(rows: &[Row]) -> String {
     let header = [
-        "EN", "NS", "AD", "ZD", "AF", "D1S", "D2S", "D3S", "TV", "policy", "once", "calib",
-        "p50 ms", "p99 ms",
+        "EN", "NS", "AD", "ZD", "AF", "D1S", "D2S", "D3S", "D4+S", "TV", "policy", "once", "calib",
+        "p50 ms", "p99 ms", "cells", "viol%", "sviol%",
     ];
-    let body: Vec<[String; 14]> = rows
+    let percent = |x: Option<f64>| x.map(|x| 100.0 * x);
+    let body: Vec<[String; 18]> = rows
         .iter()
         .map(|r| {
             let (m, c) = (&r.metrics, &r.ci95);
@@ -39,6 +44,7 @@ pub fn table(rows: &[Row]) -> String {
                 pm(m.d1s, c.d1s, 1),
                 pm(m.d2s, c.d2s, 2),
                 pm(m.d3s, c.d3s, 2),
+                pm(m.d4s, c.d4s, 2),
                 r.target_speed
                     .map_or_else(|| "mix".to_owned(), |v| v.to_string()),
                 r.policy.clone(),
@@ -46,6 +52,13 @@ pub fn table(rows: &[Row]) -> String {
                 opt(m.calibration, c.calibration, 2),
                 opt(m.plan_ms_p50, c.plan_ms_p50, 2),
                 opt(m.plan_ms_p99, c.plan_ms_p99, 2),
+                pm(m.cells, c.cells, 2),
+                opt(percent(m.violating_plans), percent(c.violating_plans), 1),
+                opt(
+                    percent(m.violating_sensor_plans),
+                    percent(c.violating_sensor_plans),
+                    1,
+                ),
             ]
         })
         .collect();
@@ -71,7 +84,7 @@ pub fn table(rows: &[Row]) -> String {
 }
 
 /// The JSON report: `{"runs":[{label, policy, scenario, sensors, fleet,
-/// target_speed, steps, seeds, metrics, ci95}]}`.
+/// target_speed, steps, min_separation, seeds, metrics, ci95}]}`.
 pub fn json(rows: &[Row]) -> serde_json::Result<String> {
     #[derive(Serialize)]
     struct Report<'a> {

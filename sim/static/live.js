@@ -37,7 +37,8 @@ function setup(data) {
   $("title").textContent = `· ${init.scenario} · ${init.policy} · ${init.sensors} sensors · seed ${init.seed}`;
   $("run-info").textContent =
     `${init.steps} measured steps after a ${init.warmup}-step warm-up · T = ${init.horizon} · ` +
-    `zone ${init.width}×${init.height}, cells of ${init.cell_size}`;
+    `zone ${init.width}×${init.height}, cells of ${init.cell_size}` +
+    (init.min_separation > 0 ? ` · sensors ≥ ${init.min_separation} cells apart` : "");
   $("prio-max").textContent = String(init.sensors);
   const sel = $("explain-sensor");
   sel.innerHTML = "";
@@ -288,6 +289,10 @@ function panel(f) {
   $("m-plan").textContent = fmt(m.plan_ms, 1);
   $("m-plan-mean").textContent = fmt(m.plan_ms_mean, 1);
   $("m-inzone").textContent = f.step ? String(m.in_zone) : "–";
+  $("m-cells").textContent = f.step ? String(m.cells) : "–";
+  $("m-cells-mean").textContent = f.step ? fmt(m.cells_mean, 2) : "–";
+  $("m-viol").textContent = m.violations == null ? "–" : String(m.violations);
+  $("m-viol-mean").textContent = m.violating_plans == null ? "–" : `${fmt(100 * m.violating_plans, 1)}%`;
   chart("c-ad", f.series.ad);
   chart("c-af", f.series.af, 1);
   chart("c-once", f.series.once, 1);

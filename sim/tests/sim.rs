@@ -168,6 +168,7 @@ async fn end_to_end_over_http() {
             horizon: Some(2),
             history: 4,
             start: Start::Grid,
+            min_separation: None,
         })
         .collect();
     let rows = run_all(&client, &configs, 7, 2, 4).await.expect("runs");
@@ -177,7 +178,15 @@ async fn end_to_end_over_http() {
         assert_eq!(row.seeds, 2);
         assert!(m.ad + m.zd > 0.0, "{}: an empty zone", row.policy);
         assert!((0.0..=1.0).contains(&m.af) && (0.0..=1.0).contains(&m.detected_once));
-        assert!(m.d1s + m.d2s + m.d3s <= m.ad + 1e-9);
+        // Every detected target is seen by one, two, three, or four or more.
+        assert!((m.d1s + m.d2s + m.d3s + m.d4s - m.ad).abs() < 1e-9);
+        assert!(
+            (1.0..=4.0).contains(&m.cells),
+            "{}: cells {}",
+            row.policy,
+            m.cells
+        );
+        assert_eq!(row.min_separation, 0);
         let policy = ALL_POLICIES
             .iter()
             .find(|p| p.name() == row.policy)
@@ -185,6 +194,8 @@ async fn end_to_end_over_http() {
         let planner = policy.planner().is_some();
         assert_eq!(m.plan_ms_p50.is_some(), planner, "{}", row.policy);
         assert_eq!(m.calibration.is_some(), planner, "{}", row.policy);
+        // No separation asked for, none to violate.
+        assert_eq!(m.violating_plans, planner.then_some(0.0), "{}", row.policy);
     }
     for cfg in &configs {
         let (_, sim) = run_one(&client, cfg, 3, true).await.expect("run");
@@ -273,6 +284,7 @@ async fn fleets_move_within_their_speeds_around_no_go_zones() {
         horizon: Some(2),
         history: 4,
         start: Start::Grid,
+        min_separation: None,
     };
     let (metrics, sim) = run_one(&client, &cfg, 5, true).await.expect("run");
     let sim = sim.expect("kept");
