@@ -568,14 +568,17 @@ impl ValueGrid {
     /// Sum of the violation counts along a sequence of per-step
     /// displacements, or `None` when [`ValueGrid::path_value`] would be.
     pub fn path_violations(&self, moves: &[(i32, i32)]) -> Option<u32> {
-        self.path_value(moves)?;
+        if moves.len() > self.horizon() {
+            return None;
+        }
         let mut o = self.motion.start();
         let n = self.side() * self.side();
         let mut total = 0;
         for (t, &d) in moves.iter().enumerate() {
             o = self.motion.step(o, d)?;
-            if !self.violations.is_empty() {
-                total += u32::from(self.violations[t * n + o]);
+            self.values[t * n + o]?;
+            if let Some(&k) = self.violations.get(t * n + o) {
+                total += u32::from(k);
             }
         }
         Some(total)
@@ -614,8 +617,9 @@ impl BestPath {
 /// order. [`Score::NONE`] is "no path", below every real score.
 trait Score: Copy {
     const NONE: Self;
-    /// The score of ending a step at flat index `i`, if it has a value.
-    fn at(grid: &ValueGrid, i: usize) -> Option<Self>;
+    /// The score of ending a step at offset `o`, from that step's values
+    /// and violation counts (empty when the grid has none).
+    fn at(vals: &[Option<f64>], violations: &[u16], o: usize) -> Option<Self>;
     fn add(self, other: Self) -> Self;
     /// Strictly better.
     fn better(self, other: Self) -> bool;
@@ -625,8 +629,8 @@ trait Score: Copy {
 impl Score for f64 {
     const NONE: Self = f64::NEG_INFINITY;
     #[inline(always)]
-    fn at(grid: &ValueGrid, i: usize) -> Option<Self> {
-        grid.values[i]
+    fn at(vals: &[Option<f64>], _: &[u16], o: usize) -> Option<Self> {
+        vals[o]
     }
     #[inline(always)]
     fn add(self, other: Self) -> Self {
@@ -656,9 +660,9 @@ impl Score for Lex {
         value: f64::NEG_INFINITY,
     };
     #[inline(always)]
-    fn at(grid: &ValueGrid, i: usize) -> Option<Self> {
-        grid.values[i].map(|value| Lex {
-            neg_violations: -f64::from(grid.violations[i]),
+    fn at(vals: &[Option<f64>], violations: &[u16], o: usize) -> Option<Self> {
+        vals[o].map(|value| Lex {
+            neg_violations: -f64::from(violations[o]),
             value,
         })
     }
@@ -690,22 +694,15 @@ impl Score for Lex {
 /// the start's own cell has values at every step. With no path at all, the
 /// moves are all `(0, 0)` and the value is `-∞`.
 pub fn best_path(grid: &ValueGrid) -> BestPath {
-    let moves = if grid.violations.is_empty() {
+    if grid.violations.is_empty() {
         programme::<f64>(grid)
     } else {
         programme::<Lex>(grid)
-    };
-    // The value is summed in step order, as brute force sums it.
-    let value = grid.path_value(&moves);
-    BestPath {
-        violations: value.and(grid.path_violations(&moves)).unwrap_or(0),
-        value: value.unwrap_or(f64::NEG_INFINITY),
-        moves,
     }
 }
 
-/// The programme of [`best_path`] over scores `S`: the optimal moves.
-fn programme<S: Score>(grid: &ValueGrid) -> Vec<(i32, i32)> {
+/// The programme of [`best_path`] over scores `S`.
+fn programme<S: Score>(grid: &ValueGrid) -> BestPath {
     let mo = &*grid.motion;
     let (h, side, speed) = (mo.horizon, mo.side, mo.speed);
     let n = side * side;
@@ -720,14 +717,15 @@ fn programme<S: Score>(grid: &ValueGrid) -> Vec<(i32, i32)> {
     for t in (1..=h).rev() {
         let (done, later) = best.split_at_mut(t * n);
         let cur = &mut done[(t - 1) * n..];
-        let base = (t - 1) * n;
+        let vals = &grid.values[(t - 1) * n..t * n];
+        let viols = grid.violations.get((t - 1) * n..t * n).unwrap_or(&[]);
         let k = speed * t;
         let rows = e - k..=e + k;
         let cols = move |r: usize| r * side + e - k..=r * side + e + k;
         if t == h {
             for r in rows {
                 for o in cols(r) {
-                    if let Some(v) = S::at(grid, base + o) {
+                    if let Some(v) = S::at(vals, viols, o) {
                         cur[o] = v;
                     }
                 }
@@ -738,14 +736,14 @@ fn programme<S: Score>(grid: &ValueGrid) -> Vec<(i32, i32)> {
         if mo.open {
             let (lo, hi) = (e - k, e + k);
             match speed {
-                1 => open_layer::<1, S>(grid, base, side, lo, hi, next, &mut rowmax, cur),
-                2 => open_layer::<2, S>(grid, base, side, lo, hi, next, &mut rowmax, cur),
-                _ => open_layer::<3, S>(grid, base, side, lo, hi, next, &mut rowmax, cur),
+                1 => open_layer::<1, S>(vals, viols, side, lo, hi, next, &mut rowmax, cur),
+                2 => open_layer::<2, S>(vals, viols, side, lo, hi, next, &mut rowmax, cur),
+                _ => open_layer::<3, S>(vals, viols, side, lo, hi, next, &mut rowmax, cur),
             }
         } else {
             for r in rows {
                 for o in cols(r) {
-                    let Some(v) = S::at(grid, base + o) else {
+                    let Some(v) = S::at(vals, viols, o) else {
                         continue;
                     };
                     cur[o] = v.add(
@@ -759,6 +757,9 @@ fn programme<S: Score>(grid: &ValueGrid) -> Vec<(i32, i32)> {
     }
     let mut o = mo.start();
     let mut moves = Vec::with_capacity(h);
+    // The value is summed in step order, as brute force sums it.
+    let mut value = Some(0.0);
+    let mut violations = 0;
     for t in 1..=h {
         let row = &best[(t - 1) * n..t * n];
         let mut choice = o;
@@ -775,14 +776,22 @@ fn programme<S: Score>(grid: &ValueGrid) -> Vec<(i32, i32)> {
             (choice / side) as i32 - (o / side) as i32,
         ));
         o = choice;
+        value = value.zip(grid.values[(t - 1) * n + o]).map(|(a, v)| a + v);
+        if let Some(&k) = grid.violations.get((t - 1) * n + o) {
+            violations += u32::from(k);
+        }
     }
-    moves
+    BestPath {
+        moves,
+        violations: if value.is_some() { violations } else { 0 },
+        value: value.unwrap_or(f64::NEG_INFINITY),
+    }
 }
 
 /// One layer of [`best_path`]'s programme for an open motion of speed `M`
 /// (every offset free): `cur[o] = score(o) + max of next over the (2M+1)²
 /// square around o` for `o` in the box `lo..=hi` × `lo..=hi` of step t
-/// (scores at flat index `base + o`). The successors are that whole square,
+/// (scores from the step's `vals` and `viols`). The successors are that whole square,
 /// so their maximum is separable: maxima along rows into `rowmax`, then
 /// along columns. `hi + M` is inside the square of offsets (t < T), and the
 /// maximum is associative and commutative (up to the sign of zeros), so
@@ -790,8 +799,8 @@ fn programme<S: Score>(grid: &ValueGrid) -> Vec<(i32, i32)> {
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn open_layer<const M: usize, S: Score>(
-    grid: &ValueGrid,
-    base: usize,
+    vals: &[Option<f64>],
+    viols: &[u16],
     side: usize,
     lo: usize,
     hi: usize,
@@ -812,7 +821,7 @@ fn open_layer<const M: usize, S: Score>(
     for r in lo..=hi {
         let row = r * side;
         for o in row + lo..=row + hi {
-            let Some(v) = S::at(grid, base + o) else {
+            let Some(v) = S::at(vals, viols, o) else {
                 continue;
             };
             let f = (0..=2 * M).fold(S::NONE, |a, i| a.max(rowmax[o + i * side - M * side]));
