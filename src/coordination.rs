@@ -44,6 +44,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
+use crate::cancel::{CancelToken, Cancelled};
 use crate::estimator::Estimator;
 use crate::geometry::Region;
 use crate::scenario::{Cell, FovSpec, Look, Scenario};
@@ -104,6 +105,11 @@ pub struct Coordinated {
 /// moves at its type's speed through the scenario's free cells, and keeps
 /// the minimum separation `min_separation` (cells; 0 for none) from the
 /// others wherever it can (see the module docs).
+///
+/// # Errors
+/// [`Cancelled`] once `cancel` is cancelled: it is checked before every
+/// step's values of every search and between sensors and rounds, so the
+/// work stops within one sensor-step's fill.
 #[allow(clippy::too_many_arguments)]
 pub fn coordinate(
     s: &Scenario,
@@ -113,7 +119,8 @@ pub fn coordinate(
     horizon: usize,
     mode: Coordination,
     min_separation: usize,
-) -> Coordinated {
+    cancel: &CancelToken,
+) -> Result<Coordinated, Cancelled> {
     let n = starts.len();
     // Each sensor's motion (its speed, the free cells around it), built
     // once and shared by every search it runs.
@@ -133,6 +140,10 @@ pub fn coordinate(
     let plan_one = |i: usize, fill: &mut dyn FnMut(usize, &mut ValueGrid), avoid: Vec<&[Cell]>| {
         let mut grid = motions[i].clone();
         for t in 1..=grid.horizon() {
+            // The caller checks the token after the search.
+            if cancel.is_cancelled() {
+                break;
+            }
             fill(t, &mut grid);
         }
         mark_too_close(&mut grid, starts[i], d, avoid);
@@ -151,6 +162,7 @@ pub fn coordinate(
         .into_par_iter()
         .map(|i| plan_one(i, &mut |t, g| est.fill(i, starts[i], t, &[], g), Vec::new()))
         .collect();
+    cancel.check()?;
     let mut order: Vec<usize> = (0..n).collect();
     // Stable sort: ties keep request order.
     order.sort_by(|&a, &b| plans[b].value.total_cmp(&plans[a].value));
@@ -192,6 +204,7 @@ pub fn coordinate(
         // Priority: each sensor against the ones above it, in rank order.
         for rank in 1..n {
             plans[order[rank]] = ranked(&plans, rank, false);
+            cancel.check()?;
         }
     }
     if d > 0 {
@@ -210,6 +223,7 @@ pub fn coordinate(
                     continue;
                 }
                 let candidate = ranked(&plans, rank, true);
+                cancel.check()?;
                 if candidate.violations >= total.per_sensor[i] {
                     continue;
                 }
@@ -217,6 +231,7 @@ pub fn coordinate(
                 trial[i] = candidate;
                 for below in rank + 1..n {
                     trial[order[below]] = ranked(&trial, below, false);
+                    cancel.check()?;
                 }
                 let after = separation::count(&all_paths(&trial), d);
                 if after.pairs < total.pairs {
@@ -262,6 +277,7 @@ pub fn coordinate(
                         avoid,
                     )
                 };
+                cancel.check()?;
                 let current = path_moves(starts[i], &plans[i].path);
                 let current_value = grid_plan
                     .grid
@@ -287,30 +303,28 @@ pub fn coordinate(
             }
         }
     }
-    let by_step = (1..=horizon)
-        .map(|t| {
-            order
+    let mut by_step = Vec::with_capacity(horizon);
+    for t in 1..=horizon {
+        let mut total = 0.0;
+        for (rank, &p) in order.iter().enumerate() {
+            cancel.check()?;
+            let above: Vec<Look> = order[..rank]
                 .iter()
-                .enumerate()
-                .map(|(rank, &p)| {
-                    let above: Vec<Look> = order[..rank]
-                        .iter()
-                        .map(|&q| s.look(types[q], plans[q].path[t - 1]))
-                        .collect();
-                    est.value(p, plans[p].path[t - 1], t, &above)
-                })
-                .sum()
-        })
-        .collect();
+                .map(|&q| s.look(types[q], plans[q].path[t - 1]))
+                .collect();
+            total += est.value(p, plans[p].path[t - 1], t, &above);
+        }
+        by_step.push(total);
+    }
     let violations = separation::count(&all_paths(&plans), d);
-    Coordinated {
+    Ok(Coordinated {
         plans,
         order,
         by_step,
         rounds,
         repairs,
         violations,
-    }
+    })
 }
 
 fn all_paths(plans: &[SensorPlan]) -> Vec<Vec<Cell>> {

@@ -13,9 +13,11 @@
 //! - [`planner`]: a scenario's planner and the request/response types;
 //! - [`world`]: a simulation of the target process, for checks and simulators.
 //!
+//! [`cancel`] lets the HTTP layer stop a plan nobody waits for.
 //! [`http`] is the thin HTTP layer over them, and [`store`] keeps
 //! registered scenarios on disk.
 
+pub mod cancel;
 pub mod coordination;
 pub mod estimator;
 pub mod geometry;

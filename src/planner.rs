@@ -9,6 +9,7 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
+use crate::cancel::{CancelToken, Cancelled};
 use crate::coordination::{Coordination, coordinate};
 use crate::estimator::{
     ElementaryGrid, Estimator, ExactEstimator, PaperEstimator, SourceRays, Target,
@@ -464,15 +465,47 @@ impl Planner {
         Ok(self.plan(&PlanInput::new(&self.scenario, req)?))
     }
 
+    /// Validates a request and plans it unless `cancel` is cancelled
+    /// first (see [`Planner::plan_cancellable`]).
+    ///
+    /// # Errors
+    /// The outer error for an invalid request, the inner one when the work
+    /// was cancelled.
+    pub fn plan_request_cancellable(
+        &self,
+        req: &PlanRequest,
+        cancel: &CancelToken,
+    ) -> Result<Result<PlanResponse, Cancelled>, ValidationError> {
+        Ok(self.plan_cancellable(&PlanInput::new(&self.scenario, req)?, cancel))
+    }
+
     /// Plans a validated request.
     ///
     /// Runs on a worker of rayon's global pool (moving there first when
     /// called from outside it), so the plan's parallel parts split among
     /// the workers without handing work back and forth between threads.
     pub fn plan(&self, input: &PlanInput) -> PlanResponse {
-        if rayon::current_thread_index().is_none() {
-            return rayon::scope(|_| self.plan(input));
+        match self.plan_cancellable(input, &CancelToken::never()) {
+            Ok(response) => response,
+            Err(Cancelled) => unreachable!("a plan that is never cancelled finishes"),
         }
+    }
+
+    /// [`Planner::plan`], checking `cancel` between its stages and within
+    /// the search and coordination (see [`coordinate`]), so a cancelled plan
+    /// stops within one sensor-step's fill.
+    ///
+    /// # Errors
+    /// [`Cancelled`] once `cancel` is cancelled.
+    pub fn plan_cancellable(
+        &self,
+        input: &PlanInput,
+        cancel: &CancelToken,
+    ) -> Result<PlanResponse, Cancelled> {
+        if rayon::current_thread_index().is_none() {
+            return rayon::scope(|_| self.plan_cancellable(input, cancel));
+        }
+        cancel.check()?;
         let started = Instant::now();
         let s = &self.scenario;
         let est: Box<dyn Estimator + '_> = match input.estimator {
@@ -497,10 +530,12 @@ impl Planner {
                     &input.types,
                     input.horizon,
                 );
+                cancel.check()?;
                 est.prepare();
                 Box::new(est)
             }
         };
+        cancel.check()?;
         let result = coordinate(
             s,
             est.as_ref(),
@@ -509,7 +544,8 @@ impl Planner {
             input.horizon,
             input.coordination,
             input.min_separation,
-        );
+            cancel,
+        )?;
         let cell_out = |c: Cell| {
             let p = s.centre(c);
             CellOut {
@@ -539,7 +575,7 @@ impl Planner {
                 }),
             })
             .collect();
-        PlanResponse {
+        Ok(PlanResponse {
             scenario: s.id.clone(),
             horizon: input.horizon,
             estimator: input.estimator,
@@ -550,7 +586,7 @@ impl Planner {
             expected_detections: result.by_step.iter().sum(),
             expected_by_step: result.by_step,
             compute_micros: started.elapsed().as_micros() as u64,
-        }
+        })
     }
 
     /// `O_s` for s = 0, 1, …: the looks taken now and in the history (the

@@ -66,15 +66,22 @@ pub fn prometheus() -> Option<&'static PrometheusHandle> {
         .as_ref()
 }
 
-/// Counts requests by route and status, tracks those in flight, and times
-/// plans.
-pub async fn track(req: Request, next: Next) -> Response {
+/// When the request reached the server, before its time limit started: a
+/// handler whose work is cancelled reads it to tell a timeout from a
+/// client that went away.
+#[derive(Debug, Clone, Copy)]
+pub struct RequestStart(pub Instant);
+
+/// Counts requests by route and status, tracks those in flight, times
+/// plans, and marks each request with its [`RequestStart`].
+pub async fn track(mut req: Request, next: Next) -> Response {
     let route = req
         .extensions()
         .get::<MatchedPath>()
         .map_or_else(|| "unmatched".to_owned(), |p| p.as_str().to_owned());
     let method = req.method().to_string();
     let started = Instant::now();
+    req.extensions_mut().insert(RequestStart(started));
     metrics::gauge!("vigil_http_requests_in_flight").increment(1.0);
     let res = next.run(req).await;
     metrics::gauge!("vigil_http_requests_in_flight").decrement(1.0);

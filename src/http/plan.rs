@@ -1,15 +1,66 @@
 //! `POST /v1/scenarios/{id}/plan`.
 
+use std::sync::Arc;
+use std::time::Duration;
+
+use axum::Extension;
 use axum::extract::State;
 
 use super::AppState;
 use super::error::ApiError;
 use super::extract::{Json, Path};
+use super::middleware::RequestStart;
 use super::openapi::{self as doc, examples};
-use std::sync::Arc;
 
+use crate::cancel::CancelToken;
 use crate::planner::{PlanRequest, PlanResponse, Planner};
 use crate::scenario::{Scenario, ScenarioSpec};
+
+/// Cancels a plan's token if the request is dropped before the plan
+/// finished: the time limit answered 504, or the client went away (the
+/// server drops a request whose connection closed). Counts each in
+/// `vigil_cancelled_total{kind="plan", reason}`.
+struct CancelOnDrop {
+    token: CancelToken,
+    start: Option<RequestStart>,
+    timeout: Duration,
+    finished: bool,
+}
+
+impl Drop for CancelOnDrop {
+    fn drop(&mut self) {
+        if self.finished {
+            return;
+        }
+        self.token.cancel();
+        let timed_out = self
+            .start
+            .is_some_and(|RequestStart(t)| t.elapsed() >= self.timeout);
+        let reason = if timed_out { "timeout" } else { "client_gone" };
+        metrics::counter!("vigil_cancelled_total", "kind" => "plan", "reason" => reason)
+            .increment(1);
+    }
+}
+
+/// Plans `req` on rayon, cancelled as soon as nobody waits for it.
+async fn plan_on_rayon(
+    state: &AppState,
+    start: Option<RequestStart>,
+    planner: Arc<Planner>,
+    req: PlanRequest,
+) -> Result<PlanResponse, ApiError> {
+    let mut guard = CancelOnDrop {
+        token: CancelToken::new(),
+        start,
+        timeout: state.settings.request_timeout,
+        finished: false,
+    };
+    let token = guard.token.clone();
+    let res = super::on_rayon(move || planner.plan_request_cancellable(&req, &token)).await;
+    guard.finished = true;
+    // A cancelled plan that is still awaited was cancelled by its deadline.
+    res??.map_err(|_| ApiError::Timeout)
+}
 
 /// `POST /v1/scenarios/{id}/plan`, body [`PlanRequest`] → 200
 /// [`PlanResponse`]; 404 for an unknown scenario (checked before the body),
@@ -45,6 +96,7 @@ use crate::scenario::{Scenario, ScenarioSpec};
 )]
 pub async fn plan(
     State(state): State<AppState>,
+    start: Option<Extension<RequestStart>>,
     Path(id): Path<String>,
     body: Result<Json<PlanRequest>, ApiError>,
 ) -> Result<Json<PlanResponse>, ApiError> {
@@ -53,8 +105,8 @@ pub async fn plan(
         .get(&id)
         .ok_or(ApiError::ScenarioNotFound(id))?;
     let Json(req) = body?;
-    let res = super::on_rayon(move || planner.plan_request(&req)).await??;
-    Ok(Json(res))
+    let start = start.map(|Extension(s)| s);
+    Ok(Json(plan_on_rayon(&state, start, planner, req).await?))
 }
 
 /// `POST /v1/plan`: the body of `/v1/scenarios/{id}/plan` plus either
@@ -88,6 +140,7 @@ pub async fn plan(
 )]
 pub async fn plan_inline(
     State(state): State<AppState>,
+    start: Option<Extension<RequestStart>>,
     Json(body): Json<serde_json::Value>,
 ) -> Result<Json<PlanResponse>, ApiError> {
     let serde_json::Value::Object(mut fields) = body else {
@@ -139,6 +192,6 @@ pub async fn plan_inline(
             ));
         }
     };
-    let res = super::on_rayon(move || planner.plan_request(&req)).await??;
-    Ok(Json(res))
+    let start = start.map(|Extension(s)| s);
+    Ok(Json(plan_on_rayon(&state, start, planner, req).await?))
 }

@@ -3,6 +3,7 @@
 
 #![allow(clippy::unwrap_used)]
 
+mod bounded;
 mod errors;
 mod fleet;
 mod fuzz;

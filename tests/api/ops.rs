@@ -2,15 +2,14 @@
 //! durability across kill -9, a corrupt store, graceful shutdown, the
 //! stateless /v1/plan, request ids and metrics.
 
-use std::io::{BufRead, BufReader};
-use std::process::{Child, Command, Stdio};
+use std::process::Command;
 use std::time::Duration;
 
 use reqwest::{StatusCode, header};
 use serde_json::{Value, json};
 use vigil::http::config::Settings;
 
-use crate::helpers::{assert_problem, spawn_with};
+use crate::helpers::{Server, assert_problem, spawn_with, temp_dir};
 
 /// A plan request that keeps a core busy for a while: many sensors, a long
 /// horizon, iterated coordination.
@@ -209,58 +208,6 @@ async fn responses_carry_request_ids_and_metrics_are_exposed() {
     ] {
         assert!(metrics.contains(name), "{name} missing from\n{metrics}");
     }
-}
-
-/// A `vigil-server` process on a free port, with its data directory.
-struct Server {
-    child: Child,
-    address: String,
-}
-
-impl Server {
-    fn start(data_dir: &std::path::Path) -> Server {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_vigil-server"))
-            .args(["--bind", "127.0.0.1:0", "--data-dir"])
-            .arg(data_dir)
-            .env("RUST_LOG", "info")
-            .env_remove("VIGIL_API_KEY")
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("vigil-server starts");
-        let stderr = child.stderr.take().expect("stderr");
-        let (tx, rx) = std::sync::mpsc::channel();
-        std::thread::spawn(move || {
-            let mut sent = false;
-            for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-                if !sent && let Some(addr) = line.split("listening on ").nth(1) {
-                    let _ = tx.send(addr.trim().to_owned());
-                    sent = true;
-                }
-            }
-        });
-        let addr = rx
-            .recv_timeout(Duration::from_secs(60))
-            .expect("the server reports its address");
-        Server {
-            child,
-            address: format!("http://{addr}"),
-        }
-    }
-}
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-fn temp_dir(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("vigil-api-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 fn small_spec(speed: f64) -> Value {
