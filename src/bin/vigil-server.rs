@@ -16,6 +16,7 @@ use clap::Parser;
 use tokio::net::TcpListener;
 use tracing_subscriber::EnvFilter;
 use vigil::http::config::{Config, LogFormat};
+use vigil::http::serve::serve;
 use vigil::http::{AppState, router};
 
 #[tokio::main]
@@ -62,9 +63,13 @@ async fn main() -> ExitCode {
     let addr = listener.local_addr().unwrap_or(config.bind);
     tracing::info!("listening on {addr}");
 
-    if let Err(e) = axum::serve(listener, router(state))
-        .with_graceful_shutdown(shutdown_signal())
-        .await
+    if let Err(e) = serve(
+        listener,
+        router(state),
+        config.conn_limits(),
+        shutdown_signal(),
+    )
+    .await
     {
         tracing::error!(error = %e, "server error");
         return ExitCode::FAILURE;

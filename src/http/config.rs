@@ -49,6 +49,29 @@ pub struct Config {
     /// MiB (least recently used are evicted).
     #[arg(long, env = "VIGIL_CACHE_MB", default_value_t = 512)]
     pub cache_mb: u64,
+    /// A connection that has not sent a whole request head within this
+    /// many milliseconds (of opening, or of its first byte after idling)
+    /// is closed.
+    #[arg(long, env = "VIGIL_HEADER_TIMEOUT_MS", default_value_t = 10_000)]
+    pub header_timeout_ms: u64,
+    /// A keep-alive connection idle for this many milliseconds is closed.
+    #[arg(long, env = "VIGIL_IDLE_TIMEOUT_MS", default_value_t = 60_000)]
+    pub idle_timeout_ms: u64,
+    /// Most connections open at once; past it a new connection is closed at
+    /// once, and the open ones are served as usual.
+    #[arg(long, env = "VIGIL_MAX_CONNECTIONS", default_value_t = 10_000)]
+    pub max_connections: usize,
+}
+
+impl Config {
+    /// The limits on connections.
+    pub fn conn_limits(&self) -> super::serve::ConnLimits {
+        super::serve::ConnLimits {
+            header_timeout: Duration::from_millis(self.header_timeout_ms.max(1)),
+            idle_timeout: Duration::from_millis(self.idle_timeout_ms.max(1)),
+            max_connections: self.max_connections.max(1),
+        }
+    }
 }
 
 /// The settings the router needs.

@@ -48,6 +48,7 @@ pub mod middleware;
 pub mod openapi;
 pub mod plan;
 pub mod scenarios;
+pub mod serve;
 
 use std::collections::BTreeMap;
 use std::collections::btree_map::Entry;

@@ -8,6 +8,7 @@ use reqwest::{Response, StatusCode, header};
 use serde_json::{Value, json};
 use tokio::net::TcpListener;
 use vigil::http::config::Settings;
+use vigil::http::serve::{ConnLimits, serve};
 use vigil::http::{AppState, Registry, router};
 
 /// A running server and a client for it.
@@ -26,6 +27,12 @@ pub async fn spawn_app() -> TestApp {
 
 /// Starts the app with the built-ins and `settings` on `127.0.0.1:0`.
 pub async fn spawn_with(settings: Settings) -> TestApp {
+    spawn_limited(settings, ConnLimits::default()).await
+}
+
+/// The same with connection limits `limits`, served as `vigil-server`
+/// serves (its accept loop).
+pub async fn spawn_limited(settings: Settings, limits: ConnLimits) -> TestApp {
     let listener = TcpListener::bind("127.0.0.1:0").await.unwrap();
     let addr = listener.local_addr().unwrap();
     let state = tokio::task::spawn_blocking(move || {
@@ -34,7 +41,9 @@ pub async fn spawn_with(settings: Settings) -> TestApp {
     .await
     .unwrap();
     tokio::spawn(async move {
-        axum::serve(listener, router(state)).await.unwrap();
+        serve(listener, router(state), limits, std::future::pending())
+            .await
+            .unwrap();
     });
     TestApp {
         address: format!("http://{addr}"),

@@ -4,6 +4,7 @@
 #![allow(clippy::unwrap_used)]
 
 mod bounded;
+mod connections;
 mod errors;
 mod fleet;
 mod fuzz;
