@@ -279,12 +279,10 @@ pub fn coordinate(
                 };
                 cancel.check()?;
                 let current = path_moves(starts[i], &plans[i].path);
-                let current_value = grid_plan
+                let (current_value, current_violations) = grid_plan
                     .grid
-                    .path_value(&current)
-                    .unwrap_or(f64::NEG_INFINITY);
-                let current_violations =
-                    grid_plan.grid.path_violations(&current).unwrap_or(u32::MAX);
+                    .path_score(&current)
+                    .unwrap_or((f64::NEG_INFINITY, u32::MAX));
                 let tol = 1e-9 * current_value.abs().max(1.0);
                 if grid_plan.violations < current_violations
                     || (grid_plan.violations == current_violations

@@ -552,36 +552,32 @@ impl ValueGrid {
     /// (see the module docs), a value along the path is missing, or there
     /// are more than T displacements.
     pub fn path_value(&self, moves: &[(i32, i32)]) -> Option<f64> {
-        if moves.len() > self.horizon() {
-            return None;
-        }
-        let n = self.side() * self.side();
-        let mut o = self.motion.start();
-        let mut total = 0.0;
-        for (t, &d) in moves.iter().enumerate() {
-            o = self.motion.step(o, d)?;
-            total += self.values[t * n + o]?;
-        }
-        Some(total)
+        self.path_score(moves).map(|(value, _)| value)
     }
 
     /// Sum of the violation counts along a sequence of per-step
     /// displacements, or `None` when [`ValueGrid::path_value`] would be.
     pub fn path_violations(&self, moves: &[(i32, i32)]) -> Option<u32> {
+        self.path_score(moves).map(|(_, violations)| violations)
+    }
+
+    /// [`ValueGrid::path_value`] and [`ValueGrid::path_violations`] in one
+    /// walk along the path.
+    pub fn path_score(&self, moves: &[(i32, i32)]) -> Option<(f64, u32)> {
         if moves.len() > self.horizon() {
             return None;
         }
-        let mut o = self.motion.start();
         let n = self.side() * self.side();
-        let mut total = 0;
+        let mut o = self.motion.start();
+        let (mut total, mut violations) = (0.0, 0);
         for (t, &d) in moves.iter().enumerate() {
             o = self.motion.step(o, d)?;
-            self.values[t * n + o]?;
+            total += self.values[t * n + o]?;
             if let Some(&k) = self.violations.get(t * n + o) {
-                total += u32::from(k);
+                violations += u32::from(k);
             }
         }
-        Some(total)
+        Some((total, violations))
     }
 }
 

@@ -17,6 +17,9 @@ use vigil::scenario::{
 use vigil::stats::Stats;
 use vigil::world::World;
 
+mod common;
+use common::one_step;
+
 fn mean_se(xs: &[f64]) -> (f64, f64) {
     let n = xs.len() as f64;
     let m = xs.iter().sum::<f64>() / n;
@@ -561,7 +564,7 @@ fn plans_respect_speeds_and_no_go_cells() {
                 let next = cell(c.col, c.row);
                 assert!(s.is_free(next), "round {round}: {next:?} is not free");
                 assert!(
-                    reachable_in_one_step(&s, at, next, speed),
+                    one_step(&s, at, speed).contains(&next),
                     "round {round}: {at:?} → {next:?} is not a legal step at speed {speed}"
                 );
                 at = next;
@@ -570,28 +573,6 @@ fn plans_respect_speeds_and_no_go_cells() {
         let total: f64 = resp.expected_by_step.iter().sum();
         assert!((total - resp.expected_detections).abs() < 1e-9);
     }
-}
-
-/// Breadth-first search over free cells: is `to` within `speed` king moves
-/// of `from`?
-fn reachable_in_one_step(s: &Scenario, from: Cell, to: Cell, speed: usize) -> bool {
-    let mut frontier = vec![from];
-    let mut seen = HashSet::from([from]);
-    for _ in 0..speed {
-        let mut next = Vec::new();
-        for c in &frontier {
-            for dr in -1..=1 {
-                for dc in -1..=1 {
-                    let n = cell(c.col + dc, c.row + dr);
-                    if s.is_free(n) && seen.insert(n) {
-                        next.push(n);
-                    }
-                }
-            }
-        }
-        frontier = next;
-    }
-    seen.contains(&to)
 }
 
 /// The paper estimator reads a type's statistics and scales by its

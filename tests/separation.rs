@@ -13,7 +13,6 @@
 //!   `paper-v10`, separation 3): how often a plan still breaks the rule.
 #![allow(clippy::unwrap_used, missing_docs)]
 
-use std::collections::HashSet;
 use std::sync::OnceLock;
 
 use proptest::prelude::*;
@@ -24,6 +23,9 @@ use vigil::planner::{
     EstimatorKind, Id, PlanRequest, PlanResponse, Planner, PositionIn, SensorIn, TargetIn,
 };
 use vigil::scenario::{Cell, FovSpec, Scenario, builtins, paper_spec};
+
+mod common;
+use common::one_step;
 
 fn cell(col: i32, row: i32) -> Cell {
     Cell { col, row }
@@ -155,27 +157,6 @@ fn recount(paths: &[Vec<Cell>], d: usize) -> (Vec<u32>, u32) {
         }
     }
     (per, pairs)
-}
-
-/// The cells within `speed` king moves of `from` through free cells.
-fn one_step(s: &Scenario, from: Cell, speed: usize) -> HashSet<Cell> {
-    let mut frontier = vec![from];
-    let mut seen = HashSet::from([from]);
-    for _ in 0..speed {
-        let mut next = Vec::new();
-        for c in &frontier {
-            for dr in -1..=1 {
-                for dc in -1..=1 {
-                    let n = cell(c.col + dc, c.row + dr);
-                    if s.is_free(n) && seen.insert(n) {
-                        next.push(n);
-                    }
-                }
-            }
-        }
-        frontier = next;
-    }
-    seen
 }
 
 const ESTIMATORS: [EstimatorKind; 2] = [EstimatorKind::Exact, EstimatorKind::Paper];
