@@ -13,12 +13,14 @@
 //! - [`planner`]: a scenario's planner and the request/response types;
 //! - [`world`]: a simulation of the target process, for checks and simulators.
 //!
-//! [`cancel`] lets the HTTP layer stop a plan nobody waits for.
+//! [`cancel`] lets the HTTP layer stop a plan nobody waits for, and [`cost`]
+//! predicts what a precomputation or a plan will cost before it starts.
 //! [`http`] is the thin HTTP layer over them, and [`store`] keeps
 //! registered scenarios on disk.
 
 pub mod cancel;
 pub mod coordination;
+pub mod cost;
 pub mod estimator;
 pub mod geometry;
 pub mod http;

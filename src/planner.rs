@@ -248,17 +248,17 @@ pub struct PlanResponse {
 #[derive(Debug, Clone)]
 pub struct PlanInput {
     ids: Vec<Id>,
-    starts: Vec<Cell>,
-    types: Vec<usize>,
-    targets: Vec<Target>,
+    pub(crate) starts: Vec<Cell>,
+    pub(crate) types: Vec<usize>,
+    pub(crate) targets: Vec<Target>,
     /// Past looks: cells and sensor types, newest first.
-    history: Vec<Vec<(Cell, usize)>>,
-    horizon: usize,
-    estimator: EstimatorKind,
-    coordination: Coordination,
-    observed: Observed,
+    pub(crate) history: Vec<Vec<(Cell, usize)>>,
+    pub(crate) horizon: usize,
+    pub(crate) estimator: EstimatorKind,
+    pub(crate) coordination: Coordination,
+    pub(crate) observed: Observed,
     explain: bool,
-    min_separation: usize,
+    pub(crate) min_separation: usize,
 }
 
 fn finite(field: impl Fn() -> String, v: f64) -> Result<f64, ValidationError> {
@@ -416,8 +416,8 @@ pub struct Planner {
     /// Its per-cell statistics, per field of view (the scenario's `fovs`;
     /// `stats[0]` is the type `default`'s).
     pub stats: Vec<Stats>,
-    rays: Vec<SourceRays>,
-    grid: Option<ElementaryGrid>,
+    pub(crate) rays: Vec<SourceRays>,
+    pub(crate) grid: Option<ElementaryGrid>,
     /// Time the precomputation took, milliseconds.
     pub precompute_ms: f64,
 }
