@@ -13,9 +13,12 @@
 //! assert_eq!(worker.check(), Err(Cancelled));
 //! assert!(CancelToken::never().check().is_ok());
 //! ```
+//!
+//! Long work (a scenario's precomputation) also reports its [`Progress`]:
+//! the share of its blocks done, for the client watching the job.
 
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 /// A shared flag: once cancelled, every clone reads cancelled.
 #[derive(Debug, Clone, Default)]
@@ -59,5 +62,43 @@ impl CancelToken {
         } else {
             Ok(())
         }
+    }
+}
+
+/// Progress of long work, counted in blocks: the worker sets the total
+/// once and advances as blocks finish; any thread reads the fraction done.
+///
+/// ```
+/// use vigil::cancel::Progress;
+/// let p = Progress::default();
+/// assert_eq!(p.fraction(), 0.0);
+/// p.add_total(4);
+/// p.advance(1);
+/// assert_eq!(p.fraction(), 0.25);
+/// ```
+#[derive(Debug, Default)]
+pub struct Progress {
+    done: AtomicUsize,
+    total: AtomicUsize,
+}
+
+impl Progress {
+    /// Adds `blocks` to the work to do.
+    pub fn add_total(&self, blocks: usize) {
+        self.total.fetch_add(blocks, Ordering::Relaxed);
+    }
+
+    /// Records `blocks` more as done.
+    pub fn advance(&self, blocks: usize) {
+        self.done.fetch_add(blocks, Ordering::Relaxed);
+    }
+
+    /// The share of the blocks done, in `[0, 1]` (0 before any total).
+    pub fn fraction(&self) -> f64 {
+        let total = self.total.load(Ordering::Relaxed);
+        if total == 0 {
+            return 0.0;
+        }
+        (self.done.load(Ordering::Relaxed) as f64 / total as f64).min(1.0)
     }
 }

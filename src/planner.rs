@@ -9,7 +9,7 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use crate::cancel::{CancelToken, Cancelled};
+use crate::cancel::{CancelToken, Cancelled, Progress};
 use crate::coordination::{Coordination, coordinate};
 use crate::estimator::{
     ElementaryGrid, Estimator, ExactEstimator, PaperEstimator, SourceRays, Target,
@@ -425,24 +425,45 @@ pub struct Planner {
 impl Planner {
     /// Precomputes the statistics of a scenario.
     pub fn new(scenario: Scenario) -> Self {
+        match Self::precompute(scenario, &CancelToken::never(), &Progress::default()) {
+            Ok(planner) => planner,
+            Err(Cancelled) => unreachable!("work that is never cancelled finishes"),
+        }
+    }
+
+    /// [`Planner::new`], in blocks of cells (see
+    /// [`Stats::for_fov_cancellable`]) that check `cancel` and advance
+    /// `progress`; the indexing of rays that follows is one more block.
+    /// The planner is the same as [`Planner::new`]'s.
+    ///
+    /// # Errors
+    /// [`Cancelled`] once `cancel` is cancelled.
+    pub fn precompute(
+        scenario: Scenario,
+        cancel: &CancelToken,
+        progress: &Progress,
+    ) -> Result<Self, Cancelled> {
         let started = Instant::now();
+        progress.add_total(scenario.fovs.len() * Stats::blocks(&scenario) + 1);
         let stats = scenario
             .fovs
             .iter()
-            .map(|&fov| Stats::for_fov(&scenario, fov))
-            .collect();
+            .map(|&fov| Stats::for_fov_cancellable(&scenario, fov, cancel, progress))
+            .collect::<Result<Vec<_>, _>>()?;
+        cancel.check()?;
         let mut rays = SourceRays::for_scenario(&scenario);
         let grid = ElementaryGrid::new(&scenario);
         if let Some(grid) = &grid {
             SourceRays::index_crossings(&mut rays, &scenario, grid);
         }
-        Planner {
+        progress.advance(1);
+        Ok(Planner {
             scenario,
             stats,
             rays,
             grid,
             precompute_ms: started.elapsed().as_secs_f64() * 1e3,
-        }
+        })
     }
 
     /// The statistics of the sensor type `ty`'s field of view.

@@ -43,6 +43,23 @@ pub struct ScenarioInfo {
     pub id: String,
     /// Its canonical spec.
     pub spec: ScenarioSpec,
+    /// `ready`, or `queued` / `precomputing` while the server precomputes
+    /// it as a job (absent from servers that predate jobs: ready).
+    #[serde(default)]
+    pub status: Option<String>,
+    /// Share of the precomputation done.
+    #[serde(default)]
+    pub progress: Option<f64>,
+    /// Estimated seconds until it is ready.
+    #[serde(default)]
+    pub eta_s: Option<f64>,
+}
+
+impl ScenarioInfo {
+    /// True once plans on it are served.
+    pub fn is_ready(&self) -> bool {
+        self.status.as_deref().is_none_or(|s| s == "ready")
+    }
 }
 
 impl Client {
@@ -93,6 +110,23 @@ impl Client {
             .await
     }
 
+    /// Polls `GET /v1/scenarios/{id}` until the scenario is ready (a large
+    /// one is precomputed as a job), at most once a second, calling
+    /// `report` with each pending status.
+    pub async fn wait_ready(
+        &self,
+        mut info: ScenarioInfo,
+        mut report: impl FnMut(&ScenarioInfo),
+    ) -> Result<ScenarioInfo, ClientError> {
+        while !info.is_ready() {
+            report(&info);
+            let wait = info.eta_s.unwrap_or(1.0).clamp(0.05, 1.0);
+            tokio::time::sleep(std::time::Duration::from_secs_f64(wait)).await;
+            info = self.scenario(&info.id).await?;
+        }
+        Ok(info)
+    }
+
     /// `POST /v1/scenarios/{id}/plan`, with its round-trip time in ms.
     pub async fn plan(
         &self,
@@ -111,9 +145,18 @@ impl Client {
 /// Starts a Vigil server on a free loopback port of this process and
 /// returns its base URL. It serves until the runtime shuts down.
 pub async fn spawn_local_server() -> std::io::Result<String> {
-    let state = tokio::task::spawn_blocking(vigil::http::AppState::new)
-        .await
-        .map_err(std::io::Error::other)?;
+    spawn_local_server_with(vigil::http::config::Settings::default()).await
+}
+
+/// [`spawn_local_server`] with the given settings.
+pub async fn spawn_local_server_with(
+    settings: vigil::http::config::Settings,
+) -> std::io::Result<String> {
+    let state = tokio::task::spawn_blocking(move || {
+        vigil::http::AppState::with_settings(vigil::http::Registry::with_builtins(), settings)
+    })
+    .await
+    .map_err(std::io::Error::other)?;
     let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await?;
     let addr = listener.local_addr()?;
     tokio::spawn(async move {

@@ -135,6 +135,18 @@ async fn resolve(client: &Client, scenario: &str) -> Result<(String, Scenario), 
     } else {
         client.scenario(scenario).await.map_err(|e| e.to_string())?
     };
+    let info = client
+        .wait_ready(info, |i| {
+            eprintln!(
+                "vigil-sim: scenario {} is {} ({:.0}% done, about {:.0} s left)",
+                i.id,
+                i.status.as_deref().unwrap_or("pending"),
+                100.0 * i.progress.unwrap_or(0.0),
+                i.eta_s.unwrap_or(0.0)
+            );
+        })
+        .await
+        .map_err(|e| e.to_string())?;
     let local = Scenario::new(info.spec).map_err(|e| format!("{}: {e}", info.id))?;
     Ok((info.id, local))
 }

@@ -371,3 +371,32 @@ fn fleet_strings_are_checked() {
     assert_eq!(vigil_sim::driver::fleet_size("drone:4,robot:6"), Some(10));
     assert_eq!(vigil_sim::driver::fleet_size("drone:4,robot"), None);
 }
+
+/// A scenario the server precomputes as a job: registration answers at
+/// once with a pending status, and the client waits until it is ready.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_client_waits_for_a_scenario_precomputed_as_a_job() {
+    let base = vigil_sim::client::spawn_local_server_with(vigil::http::config::Settings {
+        sync_precompute_ms: 0.0,
+        ..Default::default()
+    })
+    .await
+    .expect("server");
+    let client = Client::new(&base);
+    let mut spec = builtins().remove(0).spec;
+    spec.cell_size = 2.0;
+    let info = client.register(&spec).await.expect("accepted");
+    assert!(!info.is_ready(), "a job, not a synchronous registration");
+    let mut reports = 0;
+    let ready = client
+        .wait_ready(info, |_| reports += 1)
+        .await
+        .expect("ready");
+    assert!(ready.is_ready());
+    assert!(reports >= 1);
+    // Plans are served now.
+    let scenario = vigil::scenario::Scenario::new(ready.spec).expect("valid");
+    let mut sim = Sim::new(scenario, 2, Start::Grid, 1, 0);
+    let req = sim.plan_request(Policy::Paper, Some(2));
+    client.plan(&ready.id, &req).await.expect("planned");
+}

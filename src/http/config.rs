@@ -61,6 +61,22 @@ pub struct Config {
     /// once, and the open ones are served as usual.
     #[arg(long, env = "VIGIL_MAX_CONNECTIONS", default_value_t = 10_000)]
     pub max_connections: usize,
+    /// A scenario whose precomputation is predicted to take longer than
+    /// this many milliseconds is registered as a background job (202), and
+    /// refused inline in /v1/plan (422).
+    #[arg(long, env = "VIGIL_SYNC_PRECOMPUTE_MS", default_value_t = 1_000)]
+    pub sync_precompute_ms: u64,
+    /// Precomputation jobs running at once.
+    #[arg(long, env = "VIGIL_PRECOMPUTE_JOBS", default_value_t = 1)]
+    pub precompute_jobs: usize,
+    /// Precomputation jobs waiting at most; past it a registration that
+    /// would be a job gets 503.
+    #[arg(long, env = "VIGIL_PRECOMPUTE_QUEUE", default_value_t = 16)]
+    pub precompute_queue: usize,
+    /// A plan predicted to take more than this many milliseconds of CPU is
+    /// refused with 422 before any work starts (0: no limit).
+    #[arg(long, env = "VIGIL_MAX_PLAN_MS", default_value_t = 2_000)]
+    pub max_plan_ms: u64,
 }
 
 impl Config {
@@ -87,6 +103,25 @@ pub struct Settings {
     pub request_timeout: Duration,
     /// Memory bound of the inline-scenario cache, bytes.
     pub cache_bytes: usize,
+    /// Synchronous precompute budget, milliseconds (predicted).
+    pub sync_precompute_ms: f64,
+    /// Precomputation jobs running at once.
+    pub precompute_jobs: usize,
+    /// Precomputation jobs waiting at most.
+    pub precompute_queue: usize,
+    /// Most predicted CPU milliseconds of one plan (`None`: no limit).
+    pub max_plan_ms: Option<f64>,
+}
+
+impl Settings {
+    /// The registry's bounds on precomputation.
+    pub fn job_limits(&self) -> super::JobLimits {
+        super::JobLimits {
+            sync_precompute_ms: self.sync_precompute_ms,
+            jobs: self.precompute_jobs,
+            queue: self.precompute_queue,
+        }
+    }
 }
 
 impl Default for Settings {
@@ -97,6 +132,10 @@ impl Default for Settings {
             max_in_flight: 64,
             request_timeout: Duration::from_secs(30),
             cache_bytes: 512 << 20,
+            sync_precompute_ms: 1000.0,
+            precompute_jobs: 1,
+            precompute_queue: 16,
+            max_plan_ms: Some(2000.0),
         }
     }
 }
@@ -114,6 +153,10 @@ impl From<&Config> for Settings {
             max_in_flight: c.max_in_flight.max(1),
             request_timeout: Duration::from_millis(c.request_timeout_ms.max(1)),
             cache_bytes: usize::try_from(c.cache_mb.saturating_mul(1 << 20)).unwrap_or(usize::MAX),
+            sync_precompute_ms: c.sync_precompute_ms as f64,
+            precompute_jobs: c.precompute_jobs.max(1),
+            precompute_queue: c.precompute_queue,
+            max_plan_ms: (c.max_plan_ms > 0).then_some(c.max_plan_ms as f64),
         }
     }
 }

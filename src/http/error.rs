@@ -75,6 +75,43 @@ pub enum ApiError {
     /// A request-level bound other than a field's. 422.
     #[error("{0}")]
     Unprocessable(String),
+    /// The scenario is still being precomputed. 503 with Retry-After.
+    #[error("scenario `{id}` is still {}; retry in about {} s", if status.queue_position.is_some() { "queued for precomputation" } else { "precomputing" }, status.retry_after_s())]
+    ScenarioNotReady {
+        /// The scenario's id.
+        id: String,
+        /// Its job's status.
+        status: super::registry::JobStatus,
+    },
+    /// The precomputation queue is full. 503 with Retry-After.
+    #[error("{limit} precomputation jobs are already waiting; retry in about {retry_after_s} s")]
+    QueueFull {
+        /// The queue's bound.
+        limit: usize,
+        /// Seconds until a slot is likely to free.
+        retry_after_s: u64,
+    },
+    /// A plan predicted to cost more than the server allows. 422.
+    #[error(
+        "this plan is predicted to take {predicted_ms:.0} ms of CPU, above this server's limit of {limit_ms:.0} ms (--max-plan-ms); plan fewer sensors, a shorter horizon, fewer targets or less history, or `priority` coordination"
+    )]
+    PlanTooCostly {
+        /// Predicted CPU time, milliseconds.
+        predicted_ms: f64,
+        /// The limit, milliseconds.
+        limit_ms: f64,
+    },
+    /// An inline scenario whose precomputation would exceed the synchronous
+    /// budget. 422.
+    #[error(
+        "scenario: its precomputation is predicted to take {predicted_ms:.0} ms, above this server's synchronous budget of {budget_ms:.0} ms (--sync-precompute-ms); register it with POST /v1/scenarios (it is precomputed as a job) and plan with its `scenario_id` once it is ready"
+    )]
+    PrecomputeTooCostly {
+        /// Predicted wall time, milliseconds.
+        predicted_ms: f64,
+        /// The budget, milliseconds.
+        budget_ms: f64,
+    },
     /// A bug: a background task failed or a response could not be built. 500.
     #[error("internal error: {0}")]
     Internal(String),
@@ -118,7 +155,12 @@ impl ApiError {
             ApiError::Unauthorized => StatusCode::UNAUTHORIZED,
             ApiError::Overloaded => StatusCode::SERVICE_UNAVAILABLE,
             ApiError::Timeout => StatusCode::GATEWAY_TIMEOUT,
-            ApiError::Unprocessable(_) => StatusCode::UNPROCESSABLE_ENTITY,
+            ApiError::Unprocessable(_)
+            | ApiError::PlanTooCostly { .. }
+            | ApiError::PrecomputeTooCostly { .. } => StatusCode::UNPROCESSABLE_ENTITY,
+            ApiError::ScenarioNotReady { .. } | ApiError::QueueFull { .. } => {
+                StatusCode::SERVICE_UNAVAILABLE
+            }
             ApiError::Internal(_) => StatusCode::INTERNAL_SERVER_ERROR,
         }
     }
@@ -142,6 +184,12 @@ impl ApiError {
             ApiError::Overloaded => ("overloaded", "Service overloaded"),
             ApiError::Timeout => ("timeout", "Request timed out"),
             ApiError::Unprocessable(_) => ("validation", "Invalid request"),
+            ApiError::ScenarioNotReady { .. } => ("scenario-not-ready", "Scenario not ready"),
+            ApiError::QueueFull { .. } => ("precompute-queue-full", "Precompute queue full"),
+            ApiError::PlanTooCostly { .. } => ("plan-too-costly", "Plan too costly"),
+            ApiError::PrecomputeTooCostly { .. } => {
+                ("precompute-too-costly", "Scenario too large to plan inline")
+            }
             ApiError::Internal(_) => ("internal", "Internal server error"),
         }
     }
@@ -176,6 +224,15 @@ impl IntoResponse for ApiError {
         match self {
             ApiError::Overloaded => {
                 headers.insert(header::RETRY_AFTER, HeaderValue::from_static("1"));
+            }
+            ApiError::ScenarioNotReady { status, .. } => {
+                headers.insert(
+                    header::RETRY_AFTER,
+                    HeaderValue::from(status.retry_after_s()),
+                );
+            }
+            ApiError::QueueFull { retry_after_s, .. } => {
+                headers.insert(header::RETRY_AFTER, HeaderValue::from(retry_after_s));
             }
             ApiError::Unauthorized => {
                 headers.insert(header::WWW_AUTHENTICATE, HeaderValue::from_static("Bearer"));

@@ -47,13 +47,12 @@ pub mod health;
 pub mod middleware;
 pub mod openapi;
 pub mod plan;
+pub mod registry;
 pub mod scenarios;
 pub mod serve;
 
-use std::collections::BTreeMap;
-use std::collections::btree_map::Entry;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Arc, OnceLock, PoisonError, RwLock};
+use std::sync::{Arc, OnceLock};
 
 use axum::Router;
 use axum::error_handling::HandleErrorLayer;
@@ -70,10 +69,8 @@ use self::cache::PlannerCache;
 use self::config::{Config, Settings};
 use crate::store::Store;
 
-use crate::planner::Planner;
-use crate::scenario::{BUILTIN_IDS, builtins};
-
 pub use error::{ApiError, Problem};
+pub use registry::{JobLimits, Registry, precompute};
 
 /// Largest request body accepted, bytes. Large enough for a plan request
 /// with the most targets allowed ([`MAX_TARGETS`](crate::planner::MAX_TARGETS))
@@ -170,152 +167,6 @@ pub async fn on_rayon<T: Send + 'static>(
     }
 }
 
-/// Precomputes a scenario's statistics on a thread pool of its own: the
-/// statistics are computed in parallel, and on the global rayon pool a large
-/// scenario's many tasks would sit ahead of every plan's until it finished.
-/// Here the two share the cores through the OS scheduler instead, so
-/// registering a large scenario does not stall plan traffic.
-pub fn precompute(scenario: crate::scenario::Scenario) -> Planner {
-    static POOL: std::sync::OnceLock<Option<rayon::ThreadPool>> = std::sync::OnceLock::new();
-    let pool = POOL.get_or_init(|| {
-        rayon::ThreadPoolBuilder::new()
-            .thread_name(|i| format!("vigil-precompute-{i}"))
-            .build()
-            .map_err(|e| tracing::warn!(error = %e, "no precompute pool; using the global one"))
-            .ok()
-    });
-    let planner = match pool {
-        Some(pool) => pool.install(|| Planner::new(scenario)),
-        None => Planner::new(scenario),
-    };
-    metrics::histogram!("vigil_precompute_seconds").record(planner.precompute_ms / 1e3);
-    planner
-}
-
-/// The registered scenarios, each with its precomputed [`Planner`].
-#[derive(Debug, Default)]
-pub struct Registry {
-    planners: RwLock<BTreeMap<String, Arc<Planner>>>,
-    store: Option<Store>,
-}
-
-impl Registry {
-    /// A registry with no scenarios.
-    pub fn empty() -> Self {
-        Self::default()
-    }
-
-    /// A registry holding the built-in scenarios ([`BUILTIN_IDS`]),
-    /// precomputed now.
-    pub fn with_builtins() -> Self {
-        let planners = builtins()
-            .into_iter()
-            .map(|s| (s.id.clone(), Arc::new(Planner::new(s))))
-            .collect();
-        let registry = Self {
-            planners: RwLock::new(planners),
-            store: None,
-        };
-        registry.update_gauge();
-        registry
-    }
-
-    /// The built-ins plus the scenarios kept in `store`, whose statistics
-    /// are rebuilt now (in parallel); new registrations are written there.
-    pub fn with_store(store: Store, stored: Vec<crate::scenario::Scenario>) -> Self {
-        use rayon::prelude::*;
-        let mut registry = Self::with_builtins();
-        let planners: Vec<Planner> = stored.into_par_iter().map(precompute).collect();
-        {
-            let mut map = registry.write();
-            for p in planners {
-                tracing::info!(id = %p.scenario.id, precompute_ms = p.precompute_ms, "loaded a stored scenario");
-                map.entry(p.scenario.id.clone())
-                    .or_insert_with(|| Arc::new(p));
-            }
-        }
-        registry.store = Some(store);
-        registry.update_gauge();
-        registry
-    }
-
-    fn update_gauge(&self) {
-        metrics::gauge!("vigil_scenarios_loaded").set(self.read().len() as f64);
-    }
-
-    /// True for the ids of built-in scenarios, which cannot be deleted.
-    pub fn is_builtin(id: &str) -> bool {
-        BUILTIN_IDS.contains(&id)
-    }
-
-    // A panic while holding the lock cannot leave the map half-updated (every
-    // critical section is a single map operation), so poisoning is ignored.
-    fn read(&self) -> std::sync::RwLockReadGuard<'_, BTreeMap<String, Arc<Planner>>> {
-        self.planners.read().unwrap_or_else(PoisonError::into_inner)
-    }
-
-    fn write(&self) -> std::sync::RwLockWriteGuard<'_, BTreeMap<String, Arc<Planner>>> {
-        self.planners
-            .write()
-            .unwrap_or_else(PoisonError::into_inner)
-    }
-
-    /// The planner of a scenario.
-    pub fn get(&self, id: &str) -> Option<Arc<Planner>> {
-        self.read().get(id).cloned()
-    }
-
-    /// Every planner, sorted by scenario id.
-    pub fn list(&self) -> Vec<Arc<Planner>> {
-        self.read().values().cloned().collect()
-    }
-
-    /// Registers a planner under its scenario's id unless one is already
-    /// there, writing it to the store first (so an acknowledged scenario is
-    /// on disk). Returns the planner now registered under that id and
-    /// whether it is the one passed in. Blocking I/O: call it off the async
-    /// workers.
-    pub fn insert(&self, planner: Arc<Planner>) -> Result<(Arc<Planner>, bool), ApiError> {
-        if let Some(existing) = self.get(&planner.scenario.id) {
-            return Ok((existing, false));
-        }
-        if let Some(store) = &self.store {
-            store.save(&planner.scenario).map_err(|e| {
-                ApiError::Internal(format!("storing scenario {}: {e}", planner.scenario.id))
-            })?;
-        }
-        let out = match self.write().entry(planner.scenario.id.clone()) {
-            Entry::Occupied(e) => (Arc::clone(e.get()), false),
-            Entry::Vacant(e) => (Arc::clone(e.insert(planner)), true),
-        };
-        self.update_gauge();
-        Ok(out)
-    }
-
-    /// Removes a scenario, from the store too. Fails with
-    /// [`ApiError::BuiltinScenario`] for a built-in and
-    /// [`ApiError::ScenarioNotFound`] for an unknown id. Blocking I/O.
-    pub fn remove(&self, id: &str) -> Result<Arc<Planner>, ApiError> {
-        if Self::is_builtin(id) {
-            return Err(ApiError::BuiltinScenario(id.to_owned()));
-        }
-        if self.get(id).is_none() {
-            return Err(ApiError::ScenarioNotFound(id.to_owned()));
-        }
-        if let Some(store) = &self.store {
-            store
-                .remove(id)
-                .map_err(|e| ApiError::Internal(format!("removing scenario {id}: {e}")))?;
-        }
-        let removed = self
-            .write()
-            .remove(id)
-            .ok_or_else(|| ApiError::ScenarioNotFound(id.to_owned()));
-        self.update_gauge();
-        removed
-    }
-}
-
 /// State shared by every handler.
 #[derive(Debug, Clone)]
 pub struct AppState {
@@ -340,8 +191,10 @@ impl AppState {
         Self::with_settings(registry, Settings::default())
     }
 
-    /// State over a given registry and settings.
+    /// State over a given registry and settings (which set the registry's
+    /// bounds on precomputation).
     pub fn with_settings(registry: Registry, settings: Settings) -> Self {
+        registry.set_limits(settings.job_limits());
         Self {
             registry: Arc::new(registry),
             cache: Arc::new(PlannerCache::new(settings.cache_bytes)),
@@ -353,9 +206,10 @@ impl AppState {
     /// `data_dir` and rebuilds the statistics of what it holds.
     pub fn from_config(config: &Config) -> std::io::Result<Self> {
         let (store, stored) = Store::open(&config.data_dir)?;
+        let settings = Settings::from(config);
         Ok(Self::with_settings(
-            Registry::with_store(store, stored),
-            Settings::from(config),
+            Registry::with_store(store, stored, settings.job_limits()),
+            settings,
         ))
     }
 }

@@ -16,6 +16,7 @@ use utoipa::openapi::{Ref, RefOr};
 use utoipa::{Modify, OpenApi, ToResponse, ToSchema};
 
 use super::error::{ApiError, Problem};
+use super::registry::JobStatus;
 use super::{health, middleware, plan, scenarios};
 use crate::coordination::Coordination;
 use crate::planner::{
@@ -74,6 +75,8 @@ Every error is an RFC 9457 problem (`application/problem+json`, schema \
             InvalidInlinePlanRequest,
             Unauthorized,
             Overloaded,
+            NotReady,
+            QueueFull,
             Timeout,
         )
     ),
@@ -410,13 +413,18 @@ pub struct InvalidScenario(pub Problem);
         ("horizon" = (summary = "Horizon out of range", value = json!(invalid(
             "horizon", "must be in 1..=12, got 0"
         )))),
+        ("too-costly" = (summary = "Predicted to cost more CPU than the server allows", value = json!(problem(
+            ApiError::PlanTooCostly { predicted_ms: 14210.0, limit_ms: 2000.0 }
+        )))),
     )
 )]
 pub struct InvalidPlanRequest(pub Problem);
 
 /// The request is well-formed but a value is outside its bounds (fields of
 /// an inline scenario are prefixed with `scenario.`), or it gives both or
-/// neither of `scenario_id` and `scenario`.
+/// neither of `scenario_id` and `scenario`, or the plan or the inline
+/// scenario's precomputation is predicted to cost more than the server
+/// allows.
 #[derive(Debug, ToResponse)]
 #[response(
     content_type = "application/problem+json",
@@ -426,6 +434,12 @@ pub struct InvalidPlanRequest(pub Problem);
         )))),
         ("scenario" = (summary = "An invalid inline scenario", value = json!(invalid(
             "scenario.zone.width", "100 is not a whole multiple of cell_size 7"
+        )))),
+        ("register-instead" = (summary = "An inline scenario too large to precompute synchronously", value = json!(problem(
+            ApiError::PrecomputeTooCostly { predicted_ms: 486000.0, budget_ms: 1000.0 }
+        )))),
+        ("too-costly" = (summary = "Predicted to cost more CPU than the server allows", value = json!(problem(
+            ApiError::PlanTooCostly { predicted_ms: 14210.0, limit_ms: 2000.0 }
         )))),
         ("outside" = (summary = "A sensor outside the zone", value = json!(invalid(
             "sensors[0]", "(400, 10) is outside the zone [0,300]×[0,300]"
@@ -452,6 +466,42 @@ pub struct Unauthorized(pub Problem);
     example = json!(problem(ApiError::Overloaded))
 )]
 pub struct Overloaded(pub Problem);
+
+/// The server is handling as many `/v1` requests as it allows (shed at
+/// once, without being handled), or the scenario is still being
+/// precomputed (`GET /v1/scenarios/{id}` shows its progress). Retry after
+/// the delay given: for a pending scenario, its estimated time to ready.
+#[derive(Debug, ToResponse)]
+#[response(
+    content_type = "application/problem+json",
+    headers(("Retry-After" = String, description = "Seconds to wait before retrying.")),
+    examples(
+        ("not-ready" = (summary = "The scenario is still precomputing", value = json!(problem(
+            ApiError::ScenarioNotReady {
+                id: "s-3f6c0a9d2b7e4411".to_owned(),
+                status: JobStatus { queue_position: None, progress: 0.42, eta_s: 12.3 },
+            }
+        )))),
+        ("overloaded" = (summary = "Shed under load", value = json!(problem(ApiError::Overloaded)))),
+    )
+)]
+pub struct NotReady(pub Problem);
+
+/// The server is handling as many `/v1` requests as it allows (shed at
+/// once), or as many precomputation jobs wait as its queue holds
+/// (`--precompute-queue`). Retry after the delay given.
+#[derive(Debug, ToResponse)]
+#[response(
+    content_type = "application/problem+json",
+    headers(("Retry-After" = String, description = "Seconds to wait before retrying.")),
+    examples(
+        ("queue-full" = (summary = "The precomputation queue is full", value = json!(problem(
+            ApiError::QueueFull { limit: 16, retry_after_s: 40 }
+        )))),
+        ("overloaded" = (summary = "Shed under load", value = json!(problem(ApiError::Overloaded)))),
+    )
+)]
+pub struct QueueFull(pub Problem);
 
 /// The request took longer than the server's time limit.
 #[derive(Debug, ToResponse)]
@@ -501,7 +551,57 @@ pub mod examples {
             "id": id,
             "spec": spec,
             "grid": {"cols": 10, "rows": 10},
+            "status": "ready",
+            "progress": 1.0,
+            "predicted_precompute_ms": 0.2,
             "summary": {"expected_targets_in_zone": 5.4993, "precompute_ms": 0.13}
+        })
+    }
+
+    /// A large scenario: a 2000×2000 zone of unit cells, a circular field
+    /// of view of radius 40, four sources.
+    pub fn large_spec() -> Value {
+        json!({
+            "name": "large",
+            "zone": {"width": 2000.0, "height": 2000.0},
+            "cell_size": 1.0,
+            "fov": {"shape": "circle", "radius": 40.0},
+            "target_speed": 10.0,
+            "sources": [
+                {"x": -1.0, "y": 1000.0, "rate": 0.5},
+                {"x": 2001.0, "y": 1000.0, "rate": 0.5},
+                {"x": 1000.0, "y": -1.0, "rate": 0.5},
+                {"x": 1000.0, "y": 2001.0, "rate": 0.5}
+            ]
+        })
+    }
+
+    /// The summary of [`large_spec`] while its job precomputes it.
+    pub fn large_precomputing() -> Value {
+        let (id, spec) = registered(large_spec());
+        json!({
+            "id": id,
+            "spec": spec,
+            "grid": {"cols": 2000, "rows": 2000},
+            "status": "precomputing",
+            "progress": 0.42,
+            "eta_s": 33.1,
+            "predicted_precompute_ms": 57000.0
+        })
+    }
+
+    /// The summary of [`large_spec`] while its job waits behind another.
+    pub fn large_queued() -> Value {
+        let (id, spec) = registered(large_spec());
+        json!({
+            "id": id,
+            "spec": spec,
+            "grid": {"cols": 2000, "rows": 2000},
+            "status": "queued",
+            "progress": 0.0,
+            "eta_s": 90.4,
+            "queue_position": 1,
+            "predicted_precompute_ms": 57000.0
         })
     }
 
@@ -515,13 +615,16 @@ pub mod examples {
             "id": "paper-v10",
             "spec": spec,
             "grid": {"cols": 30, "rows": 30},
+            "status": "ready",
+            "progress": 1.0,
+            "predicted_precompute_ms": 1.6,
             "summary": {"expected_targets_in_zone": 53.0358, "precompute_ms": 1.62}
         })
     }
 
     /// A list with `paper-v10` and a registered scenario.
     pub fn scenario_list() -> Value {
-        json!({"scenarios": [paper_v10_summary(), small_summary()]})
+        json!({"scenarios": [paper_v10_summary(), small_summary(), large_precomputing()]})
     }
 
     /// Statistics of a 3×2 lattice (a 30×20 zone of 10-unit cells, circular

@@ -12,19 +12,50 @@ use super::extract::{Json, Path};
 use super::middleware::RequestStart;
 use super::openapi::{self as doc, examples};
 
-use crate::cancel::CancelToken;
-use crate::planner::{PlanRequest, PlanResponse, Planner};
+use super::registry::{precompute_cancellable, predicted_precompute_ms};
+use crate::cancel::{CancelToken, Progress};
+use crate::cost;
+use crate::planner::{PlanInput, PlanRequest, PlanResponse, Planner};
 use crate::scenario::{Scenario, ScenarioSpec};
 
-/// Cancels a plan's token if the request is dropped before the plan
-/// finished: the time limit answered 504, or the client went away (the
-/// server drops a request whose connection closed). Counts each in
-/// `vigil_cancelled_total{kind="plan", reason}`.
-struct CancelOnDrop {
+/// Cancels a request's work (through its token) if the request is dropped
+/// before the work finished: the time limit answered 504, or the client
+/// went away (the server drops a request whose connection closed). Counts
+/// each in `vigil_cancelled_total{kind, reason}`.
+pub(super) struct CancelOnDrop {
+    kind: &'static str,
     token: CancelToken,
     start: Option<RequestStart>,
     timeout: Duration,
     finished: bool,
+}
+
+impl CancelOnDrop {
+    /// A guard for work of `kind` (`plan`, `precompute`) in a request that
+    /// started at `start`.
+    pub(super) fn new(
+        kind: &'static str,
+        start: Option<Extension<RequestStart>>,
+        state: &AppState,
+    ) -> Self {
+        Self {
+            kind,
+            token: CancelToken::new(),
+            start: start.map(|Extension(s)| s),
+            timeout: state.settings.request_timeout,
+            finished: false,
+        }
+    }
+
+    /// The token the work checks.
+    pub(super) fn token(&self) -> CancelToken {
+        self.token.clone()
+    }
+
+    /// The work ended: dropping the guard now cancels nothing.
+    pub(super) fn finish(mut self) {
+        self.finished = true;
+    }
 }
 
 impl Drop for CancelOnDrop {
@@ -37,29 +68,36 @@ impl Drop for CancelOnDrop {
             .start
             .is_some_and(|RequestStart(t)| t.elapsed() >= self.timeout);
         let reason = if timed_out { "timeout" } else { "client_gone" };
-        metrics::counter!("vigil_cancelled_total", "kind" => "plan", "reason" => reason)
+        metrics::counter!("vigil_cancelled_total", "kind" => self.kind, "reason" => reason)
             .increment(1);
     }
 }
 
-/// Plans `req` on rayon, cancelled as soon as nobody waits for it.
+/// Validates `req`, refuses it if its predicted cost is above the limit,
+/// and plans it on rayon, cancelled as soon as nobody waits for it.
 async fn plan_on_rayon(
     state: &AppState,
-    start: Option<RequestStart>,
+    start: Option<Extension<RequestStart>>,
     planner: Arc<Planner>,
     req: PlanRequest,
 ) -> Result<PlanResponse, ApiError> {
-    let mut guard = CancelOnDrop {
-        token: CancelToken::new(),
-        start,
-        timeout: state.settings.request_timeout,
-        finished: false,
-    };
-    let token = guard.token.clone();
-    let res = super::on_rayon(move || planner.plan_request_cancellable(&req, &token)).await;
-    guard.finished = true;
+    let input = PlanInput::new(&planner.scenario, &req)?;
+    if let Some(limit_ms) = state.settings.max_plan_ms {
+        let predicted_ms = cost::plan_ms(&planner, &input);
+        if predicted_ms > limit_ms {
+            metrics::counter!("vigil_plans_refused_total", "reason" => "cost").increment(1);
+            return Err(ApiError::PlanTooCostly {
+                predicted_ms,
+                limit_ms,
+            });
+        }
+    }
+    let guard = CancelOnDrop::new("plan", start, state);
+    let token = guard.token();
+    let res = super::on_rayon(move || planner.plan_cancellable(&input, &token)).await;
+    guard.finish();
     // A cancelled plan that is still awaited was cancelled by its deadline.
-    res??.map_err(|_| ApiError::Timeout)
+    res?.map_err(|_| ApiError::Timeout)
 }
 
 /// `POST /v1/scenarios/{id}/plan`, body [`PlanRequest`] → 200
@@ -74,7 +112,9 @@ async fn plan_on_rayon(
     description = concat!("Plans coordinated T-step paths for the sensors that maximise the expected \
         number of distinct targets detected, given the targets reported now (and optionally the \
         sensors' past positions). Positions are snapped to the scenario's lattice. The scenario \
-        is looked up before the body is read, so an unknown id is 404 whatever the body.", plan_rules!()),
+        is looked up before the body is read, so an unknown id is 404 whatever the body (and one \
+        still being precomputed 503). A plan whose cost the server predicts above its limit \
+        (`--max-plan-ms`, 2 s of CPU by default) is refused with 422 before any work starts.", plan_rules!()),
     params(("id" = String, Path, description = doc::SCENARIO_ID, example = "paper-v10")),
     request_body(content = PlanRequest, description = "Sensors, targets and options.",
         examples(
@@ -92,6 +132,7 @@ async fn plan_on_rayon(
         (status = 404, response = doc::ScenarioNotFound),
         (status = 413, response = doc::PayloadTooLarge),
         (status = 422, response = doc::InvalidPlanRequest),
+        (status = 503, response = doc::NotReady),
     )
 )]
 pub async fn plan(
@@ -100,12 +141,8 @@ pub async fn plan(
     Path(id): Path<String>,
     body: Result<Json<PlanRequest>, ApiError>,
 ) -> Result<Json<PlanResponse>, ApiError> {
-    let planner = state
-        .registry
-        .get(&id)
-        .ok_or(ApiError::ScenarioNotFound(id))?;
+    let planner = state.registry.ready(&id)?;
     let Json(req) = body?;
-    let start = start.map(|Extension(s)| s);
     Ok(Json(plan_on_rayon(&state, start, planner, req).await?))
 }
 
@@ -123,7 +160,9 @@ pub async fn plan(
     description = concat!("The same planning as `POST /v1/scenarios/{id}/plan`, with the scenario in the \
         body: either `scenario_id` (a registered scenario, or one sent inline before) or \
         `scenario` (a spec, precomputed on first use and kept in a memory-bounded LRU cache, \
-        not registered). Exactly one of the two is required.", plan_rules!(), spec_rules!()),
+        not registered). Exactly one of the two is required. An inline scenario whose \
+        precomputation is predicted above the server's synchronous budget is refused with 422: \
+        register it instead. A plan predicted above `--max-plan-ms` is refused with 422 too.", plan_rules!(), spec_rules!()),
     request_body(content = doc::InlinePlanRequest, description = "Scenario, sensors, targets and options.",
         examples(
             ("by-id" = (summary = "paper-v10 by id", value = json!(examples::plan_request_by_id()))),
@@ -136,6 +175,7 @@ pub async fn plan(
         (status = 404, response = doc::ScenarioNotFound),
         (status = 413, response = doc::PayloadTooLarge),
         (status = 422, response = doc::InvalidInlinePlanRequest),
+        (status = 503, response = doc::NotReady),
     )
 )]
 pub async fn plan_inline(
@@ -153,11 +193,9 @@ pub async fn plan_inline(
     let req: PlanRequest = serde_json::from_value(serde_json::Value::Object(fields))
         .map_err(|e| ApiError::MalformedBody(e.to_string()))?;
     let planner: Arc<Planner> = match (scenario_id, inline) {
-        (Some(serde_json::Value::String(id)), None) => state
-            .registry
-            .get(&id)
-            .or_else(|| state.cache.get(&id))
-            .ok_or(ApiError::ScenarioNotFound(id))?,
+        (Some(serde_json::Value::String(id)), None) => {
+            registered_or_cached(&state, &id)?.ok_or(ApiError::ScenarioNotFound(id))?
+        }
         (Some(_), None) => {
             return Err(ApiError::MalformedBody(
                 "scenario_id must be a string".into(),
@@ -170,19 +208,28 @@ pub async fn plan_inline(
                 e.field = format!("scenario.{}", e.field);
                 e
             })?;
-            match state
-                .registry
-                .get(&scenario.id)
-                .or_else(|| state.cache.get(&scenario.id))
-            {
+            match registered_or_cached(&state, &scenario.id)? {
                 Some(p) => p,
                 None => {
+                    let predicted_ms = predicted_precompute_ms(&scenario);
+                    let budget_ms = state.registry.limits().sync_precompute_ms;
+                    if predicted_ms > budget_ms {
+                        return Err(ApiError::PrecomputeTooCostly {
+                            predicted_ms,
+                            budget_ms,
+                        });
+                    }
                     let cache = state.cache.clone();
-                    tokio::task::spawn_blocking(move || {
-                        let planner = super::precompute(scenario);
-                        cache.insert(Arc::new(planner))
+                    let guard = CancelOnDrop::new("precompute", start, &state);
+                    let token = guard.token();
+                    let planner = tokio::task::spawn_blocking(move || {
+                        precompute_cancellable(scenario, &token, &Progress::default())
+                            .map(|planner| cache.insert(Arc::new(planner)))
                     })
                     .await?
+                    .map_err(|_| ApiError::Timeout)?;
+                    guard.finish();
+                    planner
                 }
             }
         }
@@ -192,6 +239,15 @@ pub async fn plan_inline(
             ));
         }
     };
-    let start = start.map(|Extension(s)| s);
     Ok(Json(plan_on_rayon(&state, start, planner, req).await?))
+}
+
+/// A registered scenario's planner (503 while it is pending), else a cached
+/// inline one's, else `None`.
+fn registered_or_cached(state: &AppState, id: &str) -> Result<Option<Arc<Planner>>, ApiError> {
+    match state.registry.ready(id) {
+        Ok(p) => Ok(Some(p)),
+        Err(ApiError::ScenarioNotFound(_)) => Ok(state.cache.get(id)),
+        Err(e) => Err(e),
+    }
 }

@@ -9,10 +9,16 @@ use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
+use axum::Extension;
+
 use super::AppState;
 use super::error::ApiError;
 use super::extract::{Json, Path};
+use super::middleware::RequestStart;
 use super::openapi::{self as doc, examples};
+use super::plan::CancelOnDrop;
+use super::registry::{Entry, JobStatus, precompute_cancellable, predicted_precompute_ms};
+use crate::cancel::Progress;
 use crate::planner::Planner;
 use crate::scenario::{DEFAULT_TYPE, Scenario, ScenarioSpec};
 
@@ -34,6 +40,18 @@ pub struct SummaryStats {
     pub precompute_ms: f64,
 }
 
+/// Where a scenario is in its lifecycle.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum ScenarioStatus {
+    /// Waiting for a precomputation slot (`queue_position` says its place).
+    Queued,
+    /// Being precomputed (`progress` rises to 1).
+    Precomputing,
+    /// Precomputed: plans and statistics are served.
+    Ready,
+}
+
 /// A registered scenario, as `GET /v1/scenarios/{id}` returns it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
 pub struct ScenarioSummary {
@@ -43,22 +61,58 @@ pub struct ScenarioSummary {
     pub spec: ScenarioSpec,
     /// Lattice size.
     pub grid: Grid,
-    /// Precomputation results.
-    pub summary: SummaryStats,
+    /// `ready`, or `queued` / `precomputing` while a job precomputes it.
+    pub status: ScenarioStatus,
+    /// Share of the precomputation done, 0..1 (1 when ready).
+    #[schema(minimum = 0.0, maximum = 1.0)]
+    pub progress: f64,
+    /// Estimated seconds until it is ready; only while pending.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eta_s: Option<f64>,
+    /// Place in the precomputation queue (1 = next); only while queued.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(minimum = 1)]
+    pub queue_position: Option<usize>,
+    /// The precomputation's predicted wall time on this server,
+    /// milliseconds (above `--sync-precompute-ms` it runs as a job).
+    pub predicted_precompute_ms: f64,
+    /// Precomputation results; only when ready.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub summary: Option<SummaryStats>,
 }
 
-impl From<&Planner> for ScenarioSummary {
-    fn from(p: &Planner) -> Self {
+impl ScenarioSummary {
+    /// The summary of a registered scenario in whatever state.
+    pub fn of(entry: &Entry, job: Option<JobStatus>) -> Self {
+        let scenario = match entry {
+            Entry::Ready(p) => &p.scenario,
+            Entry::Pending(j) => &j.scenario,
+        };
+        let (status, progress) = match (entry, job) {
+            (Entry::Ready(_), _) => (ScenarioStatus::Ready, 1.0),
+            (Entry::Pending(_), Some(j)) if j.queue_position.is_some() => {
+                (ScenarioStatus::Queued, j.progress)
+            }
+            (Entry::Pending(_), j) => (ScenarioStatus::Precomputing, j.map_or(0.0, |j| j.progress)),
+        };
         Self {
-            id: p.scenario.id.clone(),
-            spec: p.scenario.spec.clone(),
+            id: scenario.id.clone(),
+            spec: scenario.spec.clone(),
             grid: Grid {
-                cols: p.scenario.cols,
-                rows: p.scenario.rows,
+                cols: scenario.cols,
+                rows: scenario.rows,
             },
-            summary: SummaryStats {
-                expected_targets_in_zone: p.stats[0].expected_targets_in_zone,
-                precompute_ms: p.precompute_ms,
+            status,
+            progress,
+            eta_s: job.map(|j| (j.eta_s * 10.0).round() / 10.0),
+            queue_position: job.and_then(|j| j.queue_position),
+            predicted_precompute_ms: (predicted_precompute_ms(scenario) * 100.0).round() / 100.0,
+            summary: match entry {
+                Entry::Ready(p) => Some(SummaryStats {
+                    expected_targets_in_zone: p.stats[0].expected_targets_in_zone,
+                    precompute_ms: p.precompute_ms,
+                }),
+                Entry::Pending(_) => None,
             },
         }
     }
@@ -124,13 +178,6 @@ pub struct StatsQuery {
     pub sensor_type: Option<String>,
 }
 
-fn lookup(state: &AppState, id: String) -> Result<Arc<Planner>, ApiError> {
-    state
-        .registry
-        .get(&id)
-        .ok_or(ApiError::ScenarioNotFound(id))
-}
-
 /// `GET /v1/scenarios` → 200 [`ScenarioList`].
 #[utoipa::path(
     get,
@@ -149,15 +196,16 @@ pub async fn list(State(state): State<AppState>) -> Json<ScenarioList> {
         .registry
         .list()
         .iter()
-        .map(|p| ScenarioSummary::from(p.as_ref()))
+        .map(|(entry, job)| ScenarioSummary::of(entry, *job))
         .collect();
     Json(ScenarioList { scenarios })
 }
 
 /// `POST /v1/scenarios`, body [`ScenarioSpec`] → 201 with the
-/// [`ScenarioSummary`] and a `Location` header when the scenario is new, 200
-/// with the registered one when its id already exists; 422 for an invalid
-/// spec.
+/// [`ScenarioSummary`] and a `Location` header when the scenario is new and
+/// precomputed at once, 202 with `Location` when it is precomputed as a job
+/// (or its job is still running), 200 with the registered one when it is
+/// ready already; 422 for an invalid spec, 503 when the job queue is full.
 #[utoipa::path(
     post,
     path = "/v1/scenarios",
@@ -166,44 +214,97 @@ pub async fn list(State(state): State<AppState>) -> Json<ScenarioList> {
     summary = "Register a scenario",
     description = concat!("Validates the spec, precomputes its per-cell statistics and registers it under \
         an id derived from the canonical spec (`s-` and 16 hex digits), so posting the same spec \
-        again is idempotent: 201 the first time, 200 with the registered scenario after.", spec_rules!()),
+        again is idempotent: 201 the first time, 200 with the registered scenario after.\n\n\
+        A scenario whose precomputation is predicted to take longer than the server's \
+        synchronous budget (`--sync-precompute-ms`, 1 s by default; the prediction is the \
+        summary's `predicted_precompute_ms`) is precomputed as a background job instead: the \
+        answer is 202 at once with its `Location`, the spec is stored durably (a restart \
+        resumes the job), and `GET` on that location shows `status` `queued` (with its \
+        `queue_position`), then `precomputing` (with `progress` rising to 1 and `eta_s`), then \
+        `ready`. Meanwhile plans and statistics on it answer 503 with `Retry-After`, and \
+        `DELETE` cancels the job. Jobs run one at a time by default (`--precompute-jobs`); \
+        past `--precompute-queue` waiting jobs a registration gets 503.", spec_rules!()),
     request_body(content = ScenarioSpec, description = "The scenario.",
-        example = json!(examples::small_spec())),
+        examples(
+            ("small" = (summary = "Precomputed at once (201)", value = json!(examples::small_spec()))),
+            ("large" = (summary = "4 million cells: precomputed as a job (202)", value = json!(examples::large_spec()))),
+        )),
     responses(
-        (status = 201, description = "Registered: the new scenario.", body = ScenarioSummary,
+        (status = 201, description = "Registered and precomputed: the new scenario.", body = ScenarioSummary,
             headers(("Location" = String, description = "`/v1/scenarios/{id}` of the new scenario.")),
             example = json!(examples::small_summary())),
-        (status = 200, description = "A scenario with this canonical spec was already registered: that one.",
+        (status = 202, description = "Accepted as a precomputation job (new, or already pending): \
+            poll the `Location` until `status` is `ready`.", body = ScenarioSummary,
+            headers(("Location" = String, description = "`/v1/scenarios/{id}` of the scenario.")),
+            examples(
+                ("precomputing" = (summary = "Running", value = json!(examples::large_precomputing()))),
+                ("queued" = (summary = "Waiting behind another job", value = json!(examples::large_queued()))),
+            )),
+        (status = 200, description = "A scenario with this canonical spec was already registered and is ready: that one.",
             body = ScenarioSummary, example = json!(examples::small_summary())),
         (status = 400, response = doc::MalformedBody),
         (status = 413, response = doc::PayloadTooLarge),
         (status = 422, response = doc::InvalidScenario),
+        (status = 503, response = doc::QueueFull),
     )
 )]
 pub async fn create(
     State(state): State<AppState>,
+    start: Option<Extension<RequestStart>>,
     Json(spec): Json<ScenarioSpec>,
 ) -> Result<Response, ApiError> {
     let scenario = Scenario::new(spec)?;
-    if let Some(existing) = state.registry.get(&scenario.id) {
-        return Ok(Json(ScenarioSummary::from(existing.as_ref())).into_response());
+    if let Some((entry, job)) = state.registry.entry(&scenario.id) {
+        return registered(&entry, job, false);
     }
-    // Precompute and store off the async workers; a 2xx means it is on disk.
     let registry = state.registry.clone();
-    let (planner, created) = tokio::task::spawn_blocking(move || {
-        let planner = super::precompute(scenario);
+    if predicted_precompute_ms(&scenario) > registry.limits().sync_precompute_ms {
+        // Stored durably before the 202, so a restart resumes it.
+        let (entry, created) =
+            tokio::task::spawn_blocking(move || registry.submit(scenario)).await??;
+        let job = state
+            .registry
+            .entry(&entry_id(&entry))
+            .and_then(|(_, job)| job);
+        return registered(&entry, job, created);
+    }
+    // Precompute and store off the async workers; a 2xx means it is on
+    // disk. Cancelled (and not stored) if nobody waits for the answer.
+    let guard = CancelOnDrop::new("precompute", start, &state);
+    let token = guard.token();
+    let (entry, created) = tokio::task::spawn_blocking(move || {
+        let planner = precompute_cancellable(scenario, &token, &Progress::default())
+            .map_err(|_| ApiError::Timeout)?;
+        token.check().map_err(|_| ApiError::Timeout)?;
         // A concurrent identical request may have registered it meanwhile;
         // the first one stays.
         registry.insert(Arc::new(planner))
     })
     .await??;
-    let body = Json(ScenarioSummary::from(planner.as_ref()));
-    if !created {
-        return Ok(body.into_response());
+    guard.finish();
+    registered(&entry, None, created)
+}
+
+fn entry_id(entry: &Entry) -> String {
+    match entry {
+        Entry::Ready(p) => p.scenario.id.clone(),
+        Entry::Pending(j) => j.scenario.id.clone(),
     }
-    let location = HeaderValue::try_from(format!("/v1/scenarios/{}", planner.scenario.id))
+}
+
+/// The answer to a registration: 201 with `Location` for a new ready
+/// scenario, 202 with `Location` for a pending one (new or not), 200 for
+/// one that was ready already.
+fn registered(entry: &Entry, job: Option<JobStatus>, created: bool) -> Result<Response, ApiError> {
+    let body = Json(ScenarioSummary::of(entry, job));
+    let status = match entry {
+        Entry::Pending(_) => StatusCode::ACCEPTED,
+        Entry::Ready(_) if created => StatusCode::CREATED,
+        Entry::Ready(_) => return Ok(body.into_response()),
+    };
+    let location = HeaderValue::try_from(format!("/v1/scenarios/{}", entry_id(entry)))
         .map_err(|e| ApiError::Internal(format!("bad Location header: {e}")))?;
-    Ok((StatusCode::CREATED, [(header::LOCATION, location)], body).into_response())
+    Ok((status, [(header::LOCATION, location)], body).into_response())
 }
 
 /// `GET /v1/scenarios/{id}` → 200 [`ScenarioSummary`]; 404 if unknown.
@@ -215,8 +316,12 @@ pub async fn create(
     summary = "Read a scenario",
     params(("id" = String, Path, description = doc::SCENARIO_ID, example = "paper-v10")),
     responses(
-        (status = 200, description = "The scenario.", body = ScenarioSummary,
-            example = json!(examples::paper_v10_summary())),
+        (status = 200, description = "The scenario, ready or still pending.", body = ScenarioSummary,
+            examples(
+                ("ready" = (summary = "Ready", value = json!(examples::paper_v10_summary()))),
+                ("precomputing" = (summary = "A job precomputing it", value = json!(examples::large_precomputing()))),
+                ("queued" = (summary = "Its job waiting", value = json!(examples::large_queued()))),
+            )),
         (status = 400, response = doc::BadPath),
         (status = 404, response = doc::ScenarioNotFound),
     )
@@ -225,8 +330,11 @@ pub async fn get(
     State(state): State<AppState>,
     Path(id): Path<String>,
 ) -> Result<Json<ScenarioSummary>, ApiError> {
-    let planner = lookup(&state, id)?;
-    Ok(Json(ScenarioSummary::from(planner.as_ref())))
+    let (entry, job) = state
+        .registry
+        .entry(&id)
+        .ok_or(ApiError::ScenarioNotFound(id))?;
+    Ok(Json(ScenarioSummary::of(&entry, job)))
 }
 
 /// `DELETE /v1/scenarios/{id}` → 204; 409 for a built-in, 404 if unknown.
@@ -236,7 +344,8 @@ pub async fn get(
     operation_id = "deleteScenario",
     tag = "scenarios",
     summary = "Delete a scenario",
-    description = "Removes a client-registered scenario. Built-in scenarios cannot be deleted.",
+    description = "Removes a client-registered scenario; if it is still being precomputed, its job \
+        is cancelled at once. Built-in scenarios cannot be deleted.",
     params(("id" = String, Path, description = doc::SCENARIO_ID, example = "paper-v10")),
     responses(
         (status = 204, description = "Deleted."),
@@ -270,6 +379,7 @@ pub async fn delete(
             example = json!(examples::stats())),
         (status = 400, response = doc::BadPath),
         (status = 404, response = doc::ScenarioNotFound),
+        (status = 503, response = doc::NotReady),
     )
 )]
 pub async fn stats(
@@ -280,7 +390,7 @@ pub async fn stats(
     let query = axum::extract::Query::<StatsQuery>::try_from_uri(&uri)
         .map_err(|e| ApiError::BadQuery(e.body_text()))?
         .0;
-    let planner = lookup(&state, id)?;
+    let planner = state.registry.ready(&id)?;
     let name = query.sensor_type.as_deref().unwrap_or(DEFAULT_TYPE);
     let ty = planner
         .scenario

@@ -9,22 +9,7 @@ use std::time::{Duration, Instant};
 use reqwest::StatusCode;
 use serde_json::{Value, json};
 
-use crate::helpers::{Server, temp_dir};
-
-/// Clock ticks per second of /proc's CPU times (`getconf CLK_TCK`; 100 on
-/// Linux).
-const TICKS_PER_S: f64 = 100.0;
-
-/// The process's CPU time (user + system), seconds, from /proc/PID/stat.
-fn cpu_seconds(pid: u32) -> f64 {
-    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).expect("/proc/PID/stat");
-    // The command name (field 2) may hold spaces: count from after it.
-    let rest = &stat[stat.rfind(')').expect("a command name") + 2..];
-    let fields: Vec<&str> = rest.split_whitespace().collect();
-    // utime and stime are fields 14 and 15 of the whole line.
-    let ticks: u64 = fields[11].parse::<u64>().unwrap() + fields[12].parse::<u64>().unwrap();
-    ticks as f64 / TICKS_PER_S
-}
+use crate::helpers::{Server, cpu_after, cpu_seconds, temp_dir, wait_busy};
 
 /// A plan on `paper-v10` that runs for seconds: 256 sensors, horizon 12,
 /// iterated coordination, 4 000 targets and 8 steps of history.
@@ -53,50 +38,19 @@ fn heavy_plan() -> Value {
            "coordination": "iterated"})
 }
 
-/// Waits until the server has used `busy` seconds of CPU over what it had
-/// at `before` (so the plan is running), or panics after 10 s.
-fn wait_busy(pid: u32, before: f64, busy: f64) {
-    let started = Instant::now();
-    while cpu_seconds(pid) < before + busy {
-        assert!(
-            started.elapsed() < Duration::from_secs(10),
-            "the plan never ran"
-        );
-        std::thread::sleep(Duration::from_millis(10));
-    }
-}
-
-/// CPU used between 200 ms and 700 ms after `since`: the work must have
-/// stopped by the first reading.
-fn cpu_after(pid: u32, since: Instant) -> f64 {
-    std::thread::sleep(Duration::from_millis(200).saturating_sub(since.elapsed()));
-    let a = cpu_seconds(pid);
-    std::thread::sleep(Duration::from_millis(500));
-    cpu_seconds(pid) - a
-}
-
 async fn cancelled_count(address: &str, reason: &str) -> f64 {
-    let text = reqwest::get(format!("{address}/metrics"))
-        .await
-        .unwrap()
-        .text()
-        .await
-        .unwrap();
-    text.lines()
-        .find(|l| {
-            l.starts_with("vigil_cancelled_total")
-                && l.contains("kind=\"plan\"")
-                && l.contains(&format!("reason=\"{reason}\""))
-        })
-        .and_then(|l| l.rsplit(' ').next())
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(0.0)
+    crate::helpers::metric(
+        address,
+        "vigil_cancelled_total",
+        &["kind=\"plan\"", &format!("reason=\"{reason}\"")],
+    )
+    .await
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_plan_stops_when_its_time_is_up() {
     let dir = temp_dir("timeout-cpu");
-    let server = Server::start_with(&dir, &["--request-timeout-ms", "400"]);
+    let server = Server::start_with(&dir, &["--request-timeout-ms", "400", "--max-plan-ms", "0"]);
     let pid = server.child.id();
     let body = heavy_plan();
     let client = reqwest::Client::new();
@@ -128,7 +82,10 @@ async fn a_plan_stops_when_its_time_is_up() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_plan_stops_when_its_client_leaves() {
     let dir = temp_dir("client-gone-cpu");
-    let server = Server::start_with(&dir, &["--request-timeout-ms", "30000"]);
+    let server = Server::start_with(
+        &dir,
+        &["--request-timeout-ms", "30000", "--max-plan-ms", "0"],
+    );
     let pid = server.child.id();
     let body = heavy_plan();
     let url = format!("{}/v1/scenarios/paper-v10/plan", server.address);
@@ -155,5 +112,51 @@ async fn a_plan_stops_when_its_client_leaves() {
         "{after} s of CPU in the 500 ms from 200 ms after the client left"
     );
     assert_eq!(cancelled_count(&server.address, "client_gone").await, 1.0);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Plans are admitted by their predicted cost: one predicted above
+/// `--max-plan-ms` is refused with 422 before any work (the process's CPU
+/// barely moves: reading and checking the body), one below it is served.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_plan_predicted_above_the_limit_is_refused_before_any_work() {
+    let dir = temp_dir("cost-limit");
+    let server = Server::start_with(&dir, &["--max-plan-ms", "500"]);
+    let pid = server.child.id();
+    let body = heavy_plan();
+    let client = reqwest::Client::new();
+    let url = format!("{}/v1/scenarios/paper-v10/plan", server.address);
+    let before = cpu_seconds(pid);
+    let res = client.post(&url).json(&body).send().await.unwrap();
+    let problem = crate::helpers::assert_problem(
+        res,
+        StatusCode::UNPROCESSABLE_ENTITY,
+        "above this server's limit of 500 ms",
+    )
+    .await;
+    assert!(
+        problem["type"]
+            .as_str()
+            .unwrap()
+            .ends_with("/plan-too-costly")
+    );
+    let used = cpu_seconds(pid) - before;
+    assert!(used <= 0.1, "{used} s of CPU to refuse a plan");
+    assert_eq!(
+        crate::helpers::metric(
+            &server.address,
+            "vigil_plans_refused_total",
+            &["reason=\"cost\""]
+        )
+        .await,
+        1.0
+    );
+    let res = client
+        .post(&url)
+        .json(&crate::helpers::plan_request())
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(res.status(), StatusCode::OK);
     let _ = std::fs::remove_dir_all(&dir);
 }

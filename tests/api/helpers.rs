@@ -2,7 +2,7 @@
 
 use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use reqwest::{Response, StatusCode, header};
 use serde_json::{Value, json};
@@ -221,4 +221,57 @@ pub fn temp_dir(name: &str) -> std::path::PathBuf {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
+}
+
+/// Clock ticks per second of /proc's CPU times (`getconf CLK_TCK`; 100 on
+/// Linux).
+pub const TICKS_PER_S: f64 = 100.0;
+
+/// The process's CPU time (user + system), seconds, from /proc/PID/stat.
+pub fn cpu_seconds(pid: u32) -> f64 {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).expect("/proc/PID/stat");
+    // The command name (field 2) may hold spaces: count from after it.
+    let rest = &stat[stat.rfind(')').expect("a command name") + 2..];
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    // utime and stime are fields 14 and 15 of the whole line.
+    let ticks: u64 = fields[11].parse::<u64>().unwrap() + fields[12].parse::<u64>().unwrap();
+    ticks as f64 / TICKS_PER_S
+}
+
+/// Waits until the server has used `busy` seconds of CPU over what it had
+/// at `before` (so the plan is running), or panics after 10 s.
+pub fn wait_busy(pid: u32, before: f64, busy: f64) {
+    let started = Instant::now();
+    while cpu_seconds(pid) < before + busy {
+        assert!(
+            started.elapsed() < Duration::from_secs(10),
+            "the plan never ran"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+/// CPU used between 200 ms and 700 ms after `since`: the work must have
+/// stopped by the first reading.
+pub fn cpu_after(pid: u32, since: Instant) -> f64 {
+    std::thread::sleep(Duration::from_millis(200).saturating_sub(since.elapsed()));
+    let a = cpu_seconds(pid);
+    std::thread::sleep(Duration::from_millis(500));
+    cpu_seconds(pid) - a
+}
+
+/// The value of a Prometheus sample of `name` whose labels include every
+/// one of `labels` (e.g. `kind="plan"`), 0 if there is none.
+pub async fn metric(address: &str, name: &str, labels: &[&str]) -> f64 {
+    let text = reqwest::get(format!("{address}/metrics"))
+        .await
+        .unwrap()
+        .text()
+        .await
+        .unwrap();
+    text.lines()
+        .find(|l| l.split(['{', ' ']).next() == Some(name) && labels.iter().all(|x| l.contains(x)))
+        .and_then(|l| l.rsplit(' ').next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0.0)
 }

@@ -9,6 +9,7 @@ mod errors;
 mod fleet;
 mod fuzz;
 mod helpers;
+mod jobs;
 mod openapi;
 mod ops;
 mod plan;

@@ -293,7 +293,7 @@ async fn scenarios_survive_kill_9_and_corrupt_files_are_skipped() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn sigterm_finishes_the_plan_in_flight_then_exits_0() {
     let dir = temp_dir("shutdown");
-    let mut server = Server::start(&dir);
+    let mut server = Server::start_with(&dir, &["--max-plan-ms", "0"]);
     let url = format!("{}/v1/scenarios/paper-v10/plan", server.address);
     // The most sensors allowed: a plan that takes well over the delay below.
     let sensors: Vec<Value> = (0..256)
@@ -331,10 +331,15 @@ async fn sigterm_finishes_the_plan_in_flight_then_exits_0() {
 }
 
 /// Precomputation runs on a pool of its own: five plans sent while a large
-/// scenario (2.25 million cells) is being registered finishes first.
+/// scenario (2.25 million cells) is being registered finish first. (With no
+/// synchronous budget, so the registration itself waits for it.)
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn registering_a_large_scenario_does_not_stall_plans() {
-    let app = crate::helpers::spawn_app().await;
+    let app = spawn_with(Settings {
+        sync_precompute_ms: f64::INFINITY,
+        ..Settings::default()
+    })
+    .await;
     let spec = json!({
         "zone": {"width": 300, "height": 300}, "cell_size": 0.2,
         "fov": {"shape": "square", "half_width": 30}, "target_speed": 10,

@@ -39,8 +39,23 @@ async fn builtin_summary_has_the_contract_fields() {
     let obj = body.as_object().unwrap();
     let mut keys: Vec<&str> = obj.keys().map(String::as_str).collect();
     keys.sort_unstable();
-    assert_eq!(keys, ["grid", "id", "spec", "summary"]);
+    assert_eq!(
+        keys,
+        [
+            "grid",
+            "id",
+            "predicted_precompute_ms",
+            "progress",
+            "spec",
+            "status",
+            "summary"
+        ]
+    );
     assert_eq!(body["id"], "paper-v10");
+    assert_eq!(body["status"], "ready");
+    assert_eq!(body["progress"], 1.0);
+    let predicted = body["predicted_precompute_ms"].as_f64().unwrap();
+    assert!(predicted.is_finite() && predicted > 0.0, "{predicted}");
     assert_eq!(body["grid"], json!({"cols": 30, "rows": 30}));
     let expected = body["summary"]["expected_targets_in_zone"]
         .as_f64()
