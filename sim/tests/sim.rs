@@ -396,7 +396,7 @@ async fn the_client_waits_for_a_scenario_precomputed_as_a_job() {
     assert!(reports >= 1);
     // Plans are served now.
     let scenario = vigil::scenario::Scenario::new(ready.spec).expect("valid");
-    let mut sim = Sim::new(scenario, 2, Start::Grid, 1, 0);
+    let sim = Sim::new(scenario, 2, Start::Grid, 1, 0);
     let req = sim.plan_request(Policy::Paper, Some(2));
     client.plan(&ready.id, &req).await.expect("planned");
 }
