@@ -19,7 +19,7 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use vigil::planner::{PlanRequest, Planner, TargetIn};
+use vigil::planner::{PlanInput, PlanRequest, Planner, TargetIn};
 use vigil::scenario::{
     FovSpec, SITE_CYCLIST, SITE_VEHICLE, SITE_WALKER, Scenario, ScenarioSpec, SourceSpec,
     SpeedSpec, ZoneSpec, builtins, site_gates_spec,
@@ -300,8 +300,34 @@ fn separation(c: &mut Criterion) {
     g.finish();
 }
 
+/// What admission adds to a request before any work: validating it and
+/// predicting its cost (`vigil::cost::plan_ms`), on the reference workload
+/// and on 256 sensors.
+fn admission(c: &mut Criterion) {
+    let planner = Planner::new(builtins().remove(0));
+    let mut g = group(c, "admission");
+    for n in [10, 256] {
+        let w = Workload {
+            sensors: n,
+            ..Workload::reference()
+        };
+        let req = w.requests(&planner, 1).remove(0);
+        let input = PlanInput::new(&planner.scenario, &req).unwrap();
+        let predicted = vigil::cost::plan_ms(&planner, &input);
+        assert!(predicted.is_finite() && predicted > 0.0);
+        g.bench_with_input(BenchmarkId::new("validate", n), &req, |b, req| {
+            b.iter(|| PlanInput::new(&planner.scenario, black_box(req)).unwrap())
+        });
+        g.bench_with_input(BenchmarkId::new("predict", n), &input, |b, input| {
+            b.iter(|| vigil::cost::plan_ms(&planner, black_box(input)))
+        });
+    }
+    g.finish();
+}
+
 criterion_group!(
     benches,
+    admission,
     horizon,
     separation,
     sensors,

@@ -414,7 +414,7 @@ pub struct InvalidScenario(pub Problem);
             "horizon", "must be in 1..=12, got 0"
         )))),
         ("too-costly" = (summary = "Predicted to cost more CPU than the server allows", value = json!(problem(
-            ApiError::PlanTooCostly { predicted_ms: 14210.0, limit_ms: 2000.0 }
+            ApiError::PlanTooCostly { predicted_ms: 19940.0, limit_ms: 2000.0 }
         )))),
     )
 )]
@@ -436,10 +436,10 @@ pub struct InvalidPlanRequest(pub Problem);
             "scenario.zone.width", "100 is not a whole multiple of cell_size 7"
         )))),
         ("register-instead" = (summary = "An inline scenario too large to precompute synchronously", value = json!(problem(
-            ApiError::PrecomputeTooCostly { predicted_ms: 486000.0, budget_ms: 1000.0 }
+            ApiError::PrecomputeTooCostly { predicted_ms: 20736.0, budget_ms: 1000.0 }
         )))),
         ("too-costly" = (summary = "Predicted to cost more CPU than the server allows", value = json!(problem(
-            ApiError::PlanTooCostly { predicted_ms: 14210.0, limit_ms: 2000.0 }
+            ApiError::PlanTooCostly { predicted_ms: 19940.0, limit_ms: 2000.0 }
         )))),
         ("outside" = (summary = "A sensor outside the zone", value = json!(invalid(
             "sensors[0]", "(400, 10) is outside the zone [0,300]×[0,300]"
@@ -479,7 +479,7 @@ pub struct Overloaded(pub Problem);
         ("not-ready" = (summary = "The scenario is still precomputing", value = json!(problem(
             ApiError::ScenarioNotReady {
                 id: "s-3f6c0a9d2b7e4411".to_owned(),
-                status: JobStatus { queue_position: None, progress: 0.42, eta_s: 12.3 },
+                status: JobStatus { queue_position: None, progress: 0.38, eta_s: 13.3 },
             }
         )))),
         ("overloaded" = (summary = "Shed under load", value = json!(problem(ApiError::Overloaded)))),
@@ -553,7 +553,7 @@ pub mod examples {
             "grid": {"cols": 10, "rows": 10},
             "status": "ready",
             "progress": 1.0,
-            "predicted_precompute_ms": 0.2,
+            "predicted_precompute_ms": 0.04,
             "summary": {"expected_targets_in_zone": 5.4993, "precompute_ms": 0.13}
         })
     }
@@ -584,9 +584,9 @@ pub mod examples {
             "spec": spec,
             "grid": {"cols": 2000, "rows": 2000},
             "status": "precomputing",
-            "progress": 0.42,
-            "eta_s": 33.1,
-            "predicted_precompute_ms": 57000.0
+            "progress": 0.38,
+            "eta_s": 13.3,
+            "predicted_precompute_ms": 20736.0
         })
     }
 
@@ -599,9 +599,9 @@ pub mod examples {
             "grid": {"cols": 2000, "rows": 2000},
             "status": "queued",
             "progress": 0.0,
-            "eta_s": 90.4,
+            "eta_s": 34.0,
             "queue_position": 1,
-            "predicted_precompute_ms": 57000.0
+            "predicted_precompute_ms": 20736.0
         })
     }
 
@@ -617,7 +617,7 @@ pub mod examples {
             "grid": {"cols": 30, "rows": 30},
             "status": "ready",
             "progress": 1.0,
-            "predicted_precompute_ms": 1.6,
+            "predicted_precompute_ms": 0.94,
             "summary": {"expected_targets_in_zone": 53.0358, "precompute_ms": 1.62}
         })
     }
