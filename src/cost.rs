@@ -80,7 +80,7 @@
 //! | paper iterated: cells × n × (1 + ov) | 7.370e-6 | every lower-ranked sensor's change |
 
 use crate::coordination::Coordination;
-use crate::estimator::{RAYS_PER_PI, RAYS_PER_PI_SQUARE};
+use crate::estimator::SourceRays;
 use crate::geometry::Point;
 use crate::planner::{EstimatorKind, Observed, PlanInput, Planner};
 use crate::scenario::{Cell, FovSpec, Scenario, Source};
@@ -224,11 +224,7 @@ fn intervals(n: i32, cell: f64, halves: &[f64]) -> f64 {
 
 /// Rays per π of the exact estimator's angular grid on `s`.
 fn density(s: &Scenario) -> f64 {
-    if s.all_square() {
-        RAYS_PER_PI_SQUARE
-    } else {
-        RAYS_PER_PI
-    }
+    SourceRays::density(s)
 }
 
 /// Per source with targets: its index, its rays and its classes.
@@ -241,9 +237,7 @@ fn source_rays(s: &Scenario) -> Vec<(usize, f64, f64)> {
         .filter(|(_, src)| src.rate > 0.0)
         .filter_map(|(j, src)| {
             let (lo, hi) = angular_span(src, &zone, &mut buf)?;
-            let rays = ((hi - lo) / std::f64::consts::PI * density(s))
-                .ceil()
-                .max(1.0);
+            let rays = SourceRays::count(lo, hi, density(s)) as f64;
             Some((j, rays, s.classes_of(j).len() as f64))
         })
         .collect()

@@ -19,12 +19,9 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use vigil::planner::{PlanInput, PlanRequest, Planner, TargetIn};
-use vigil::scenario::{
-    FovSpec, SITE_CYCLIST, SITE_VEHICLE, SITE_WALKER, Scenario, ScenarioSpec, SourceSpec,
-    SpeedSpec, ZoneSpec, builtins, site_gates_spec,
-};
-use vigil_loadtest::workload::Workload;
+use vigil::planner::{PlanInput, PlanRequest, Planner};
+use vigil::scenario::{FovSpec, Scenario, ScenarioSpec, ZoneSpec, builtins};
+use vigil_loadtest::workload::{Workload, paper_like_sources, site_with_classes, with_targets};
 
 /// Plans `req` once and checks the answer's shape.
 fn checked(planner: &Planner, req: &PlanRequest) {
@@ -117,29 +114,7 @@ fn targets(c: &mut Criterion) {
     for n in [0, 100, 1000, 5000, 20_000] {
         // The tracked targets, then more on a deterministic spiral through
         // the zone (more than the model would put there: a stress test).
-        let reqs: Vec<PlanRequest> = base
-            .iter()
-            .map(|r| {
-                let mut targets: Vec<TargetIn> = r.targets.iter().take(n).cloned().collect();
-                let mut k = 0usize;
-                while targets.len() < n {
-                    let a = k as f64 * 2.399_963;
-                    let f = ((k % 997) as f64 + 0.5) / 997.0;
-                    targets.push(TargetIn {
-                        id: None,
-                        x: s.width * (0.5 + 0.49 * f.sqrt() * a.cos()),
-                        y: s.height * (0.5 + 0.49 * f.sqrt() * a.sin()),
-                        vx: s.max_speed() * a.sin(),
-                        vy: -s.max_speed() * a.cos(),
-                    });
-                    k += 1;
-                }
-                PlanRequest {
-                    targets,
-                    ..r.clone()
-                }
-            })
-            .collect();
+        let reqs: Vec<PlanRequest> = base.iter().map(|r| with_targets(s, r, n)).collect();
         bench_requests(&mut g, &planner, n, &reqs);
     }
     g.finish();
@@ -163,7 +138,6 @@ fn history(c: &mut Criterion) {
 /// on the edges, square fields of view of 6 × 6 cells.
 pub fn lattice(side: usize) -> Scenario {
     let w = side as f64 * 10.0;
-    let src = |x: f64, y: f64| SourceSpec::at(x, y, 0.3);
     Scenario::new(ScenarioSpec {
         name: Some(format!("{side}×{side}")),
         zone: ZoneSpec {
@@ -177,16 +151,7 @@ pub fn lattice(side: usize) -> Scenario {
         sensor_types: None,
         no_go: None,
         target_speed: Some(10.0),
-        sources: vec![
-            src(-1.0, w / 3.0),
-            src(-1.0, 2.0 * w / 3.0),
-            src(w + 1.0, w / 3.0),
-            src(w + 1.0, 2.0 * w / 3.0),
-            src(w / 3.0, -1.0),
-            src(2.0 * w / 3.0, -1.0),
-            src(w / 3.0, w + 1.0),
-            src(2.0 * w / 3.0, w + 1.0),
-        ],
+        sources: paper_like_sources(w),
         horizon: Some(3.into()),
         min_separation: None,
     })
@@ -218,28 +183,6 @@ fn precompute(c: &mut Criterion) {
         });
     }
     g.finish();
-}
-
-/// `site-gates` with every source's speed distribution replaced by `k`
-/// classes spread over the walkers' to the vehicles' speed (equal weights;
-/// k = 1 is the walkers' speed alone), cones and rates unchanged.
-fn site_with_classes(k: usize) -> Scenario {
-    let mut spec = site_gates_spec();
-    let speeds: Vec<f64> = match k {
-        1 => vec![SITE_WALKER],
-        2 => vec![SITE_WALKER, SITE_VEHICLE],
-        4 => vec![SITE_WALKER, SITE_CYCLIST, 8.0, SITE_VEHICLE],
-        _ => unreachable!("k in 1, 2, 4"),
-    };
-    for src in &mut spec.sources {
-        src.speeds = Some(
-            speeds
-                .iter()
-                .map(|&speed| SpeedSpec { speed, weight: 1.0 })
-                .collect(),
-        );
-    }
-    Scenario::new(spec).unwrap()
 }
 
 /// Plan time against the number of speed classes per source on

@@ -48,12 +48,12 @@ use std::fmt::Write as _;
 
 use vigil::coordination::Coordination;
 use vigil::cost;
-use vigil::planner::{EstimatorKind, Observed, PlanInput, PlanRequest, Planner, TargetIn};
+use vigil::planner::{EstimatorKind, Observed, PlanInput, PlanRequest, Planner};
 use vigil::scenario::{
-    FovSpec, SITE_CYCLIST, SITE_VEHICLE, SITE_WALKER, Scenario, ScenarioSpec, SensorTypeSpec,
-    SourceSpec, SpeedSpec, ZoneSpec, builtins, paper_spec, site_gates_spec,
+    FovSpec, Scenario, ScenarioSpec, SensorTypeSpec, SourceSpec, ZoneSpec, builtins, paper_spec,
+    site_gates_spec,
 };
-use vigil_loadtest::workload::Workload;
+use vigil_loadtest::workload::{Workload, paper_like_sources, site_with_classes, with_targets};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 enum Group {
@@ -125,29 +125,6 @@ fn cpu_ms(mut f: impl FnMut()) -> f64 {
     batches[2]
 }
 
-/// `req` with exactly `n` targets: its own first ones, then more on a
-/// deterministic spiral through the zone (as the `cost` bench does).
-fn with_targets(s: &Scenario, req: &PlanRequest, n: usize) -> PlanRequest {
-    let mut targets: Vec<TargetIn> = req.targets.iter().take(n).cloned().collect();
-    let mut k = 0usize;
-    while targets.len() < n {
-        let a = k as f64 * 2.399_963;
-        let f = ((k % 997) as f64 + 0.5) / 997.0;
-        targets.push(TargetIn {
-            id: None,
-            x: s.width * (0.5 + 0.49 * f.sqrt() * a.cos()),
-            y: s.height * (0.5 + 0.49 * f.sqrt() * a.sin()),
-            vx: s.max_speed() * a.sin(),
-            vy: -s.max_speed() * a.cos(),
-        });
-        k += 1;
-    }
-    PlanRequest {
-        targets,
-        ..req.clone()
-    }
-}
-
 /// `k` sources of rate 0.3 spread evenly around the zone's edge, just
 /// outside it (half-planes, like the paper's).
 fn ring(w: f64, h: f64, k: usize) -> Vec<SourceSpec> {
@@ -175,17 +152,7 @@ fn ring(w: f64, h: f64, k: usize) -> Vec<SourceSpec> {
 fn lattice(side: usize, cell: f64, fov: FovSpec, k: usize) -> Scenario {
     let w = side as f64 * cell;
     let sources = if k == 8 {
-        let src = |x: f64, y: f64| SourceSpec::at(x, y, 0.3);
-        vec![
-            src(-1.0, w / 3.0),
-            src(-1.0, 2.0 * w / 3.0),
-            src(w + 1.0, w / 3.0),
-            src(w + 1.0, 2.0 * w / 3.0),
-            src(w / 3.0, -1.0),
-            src(2.0 * w / 3.0, -1.0),
-            src(w / 3.0, w + 1.0),
-            src(2.0 * w / 3.0, w + 1.0),
-        ]
+        paper_like_sources(w)
     } else {
         ring(w, w, k)
     };
@@ -217,26 +184,6 @@ fn square(h: f64) -> FovSpec {
 
 fn circle(r: f64) -> FovSpec {
     FovSpec::Circle { radius: r }
-}
-
-/// `site-gates` with every source's speeds replaced by `k` classes (as in
-/// the `cost` bench).
-fn site_with_classes(k: usize) -> Scenario {
-    let mut spec = site_gates_spec();
-    let speeds: Vec<f64> = match k {
-        1 => vec![SITE_WALKER],
-        2 => vec![SITE_WALKER, SITE_VEHICLE],
-        _ => vec![SITE_WALKER, SITE_CYCLIST, 8.0, SITE_VEHICLE],
-    };
-    for src in &mut spec.sources {
-        src.speeds = Some(
-            speeds
-                .iter()
-                .map(|&speed| SpeedSpec { speed, weight: 1.0 })
-                .collect(),
-        );
-    }
-    Scenario::new(spec).unwrap()
 }
 
 /// The paper's scenario with more sensor types of fields of view `fovs`.

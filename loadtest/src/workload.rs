@@ -7,8 +7,10 @@
 //! history and the targets seen within it (about 50), exact + priority,
 //! T = 3.
 
-use vigil::planner::{PlanRequest, Planner};
-use vigil::scenario::Scenario;
+use vigil::planner::{PlanRequest, Planner, TargetIn};
+use vigil::scenario::{
+    SITE_CYCLIST, SITE_VEHICLE, SITE_WALKER, Scenario, SourceSpec, SpeedSpec, site_gates_spec,
+};
 use vigil_sim::driver::{Sim, Start, default_warmup};
 use vigil_sim::policy::Policy;
 
@@ -80,4 +82,68 @@ impl Workload {
         }
         out
     }
+}
+
+/// `req` with exactly `n` targets: its own first ones, then more on a
+/// deterministic spiral through the zone of `s`, moving at its fastest
+/// targets' speed (more than the model would put there: a stress test of
+/// the cost of reported targets).
+pub fn with_targets(s: &Scenario, req: &PlanRequest, n: usize) -> PlanRequest {
+    let mut targets: Vec<TargetIn> = req.targets.iter().take(n).cloned().collect();
+    let mut k = 0usize;
+    while targets.len() < n {
+        let a = k as f64 * 2.399_963;
+        let f = ((k % 997) as f64 + 0.5) / 997.0;
+        targets.push(TargetIn {
+            id: None,
+            x: s.width * (0.5 + 0.49 * f.sqrt() * a.cos()),
+            y: s.height * (0.5 + 0.49 * f.sqrt() * a.sin()),
+            vx: s.max_speed() * a.sin(),
+            vy: -s.max_speed() * a.cos(),
+        });
+        k += 1;
+    }
+    PlanRequest {
+        targets,
+        ..req.clone()
+    }
+}
+
+/// `site-gates` with every source's speed distribution replaced by `k`
+/// classes spread over the walkers' to the vehicles' speed (equal weights):
+/// k = 1 is the walkers' speed alone, 2 walkers and vehicles, 4 (or more)
+/// walkers, cyclists, 8 m/step and vehicles; cones and rates unchanged.
+pub fn site_with_classes(k: usize) -> Scenario {
+    let mut spec = site_gates_spec();
+    let speeds: Vec<f64> = match k {
+        1 => vec![SITE_WALKER],
+        2 => vec![SITE_WALKER, SITE_VEHICLE],
+        _ => vec![SITE_WALKER, SITE_CYCLIST, 8.0, SITE_VEHICLE],
+    };
+    for src in &mut spec.sources {
+        src.speeds = Some(
+            speeds
+                .iter()
+                .map(|&speed| SpeedSpec { speed, weight: 1.0 })
+                .collect(),
+        );
+    }
+    // Valid: only the speed distributions of a valid spec changed.
+    Scenario::new(spec).unwrap_or_else(|e| panic!("site-gates with {k} classes: {e}"))
+}
+
+/// The paper's eight sources (two beside each edge, at thirds, rate 0.3)
+/// around a square zone of side `w`.
+pub fn paper_like_sources(w: f64) -> Vec<SourceSpec> {
+    let src = |x: f64, y: f64| SourceSpec::at(x, y, 0.3);
+    vec![
+        src(-1.0, w / 3.0),
+        src(-1.0, 2.0 * w / 3.0),
+        src(w + 1.0, w / 3.0),
+        src(w + 1.0, 2.0 * w / 3.0),
+        src(w / 3.0, -1.0),
+        src(2.0 * w / 3.0, -1.0),
+        src(w / 3.0, w + 1.0),
+        src(2.0 * w / 3.0, w + 1.0),
+    ]
 }

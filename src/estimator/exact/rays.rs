@@ -78,12 +78,25 @@ impl SourceRays {
     /// [`RAYS_PER_PI_SQUARE`] when every type's field of view is a square,
     /// else [`RAYS_PER_PI`].
     pub fn for_scenario(s: &Scenario) -> Vec<SourceRays> {
-        let density = if s.all_square() {
+        Self::with_density(s, Self::density(s))
+    }
+
+    /// Rays per π of the grids on `s`: [`RAYS_PER_PI_SQUARE`] when every
+    /// type's field of view is a square, else [`RAYS_PER_PI`].
+    pub fn density(s: &Scenario) -> f64 {
+        if s.all_square() {
             RAYS_PER_PI_SQUARE
         } else {
             RAYS_PER_PI
-        };
-        Self::with_density(s, density)
+        }
+    }
+
+    /// Rays of a grid over takeoff angles `[lo, hi]` at `rays_per_pi`
+    /// (at least one).
+    pub fn count(lo: f64, hi: f64, rays_per_pi: f64) -> usize {
+        (((hi - lo) / std::f64::consts::PI) * rays_per_pi)
+            .ceil()
+            .max(1.0) as usize
     }
 
     /// The same at `rays_per_pi` rays per π radians (for accuracy studies).
@@ -96,9 +109,7 @@ impl SourceRays {
             .filter(|(_, src)| src.rate > 0.0)
             .filter_map(|(j, src)| {
                 let (lo, hi) = angular_span(src, &zone, &mut buf)?;
-                let n = (((hi - lo) / std::f64::consts::PI) * rays_per_pi)
-                    .ceil()
-                    .max(1.0) as usize;
+                let n = Self::count(lo, hi, rays_per_pi);
                 let step = (hi - lo) / n as f64;
                 // No component exactly 0, so slab intersections need no
                 // special case (a tilt of 1e-12 rad changes nothing).
