@@ -11,6 +11,7 @@
 //! - [`coordination`]: priority and iterated coordination of several sensors;
 //! - [`separation`]: the minimum separation between sensors, counted and kept;
 //! - [`planner`]: a scenario's planner and the request/response types;
+//! - [`session`]: the state of a step-by-step client, turned into plan requests;
 //! - [`world`]: a simulation of the target process, for checks and simulators.
 //!
 //! [`cancel`] lets the HTTP layer stop a plan nobody waits for, and [`cost`]
@@ -28,6 +29,7 @@ pub mod planner;
 pub mod scenario;
 pub mod search;
 pub mod separation;
+pub mod session;
 pub mod stats;
 pub mod store;
 pub mod world;

@@ -3,8 +3,10 @@
 use std::time::{Duration, Instant};
 
 use serde::de::DeserializeOwned;
+use vigil::http::sessions::{SessionInfo, StepResponse};
 use vigil::planner::{PlanRequest, PlanResponse};
 use vigil::scenario::ScenarioSpec;
+use vigil::session::{SessionSettings, StepRequest};
 
 /// A failed call to the planner.
 #[derive(Debug, thiserror::Error)]
@@ -139,6 +141,58 @@ impl Client {
             .send(url.clone(), self.http.post(&url).json(req))
             .await?;
         Ok((resp, started.elapsed().as_secs_f64() * 1e3))
+    }
+
+    /// `POST /v1/sessions` on a registered scenario with `settings`.
+    pub async fn open_session(
+        &self,
+        scenario_id: &str,
+        settings: &SessionSettings,
+    ) -> Result<SessionInfo, ClientError> {
+        let url = format!("{}/v1/sessions", self.base);
+        let mut body = serde_json::to_value(settings).unwrap_or_default();
+        if let serde_json::Value::Object(fields) = &mut body {
+            fields.insert("scenario_id".into(), scenario_id.into());
+        }
+        self.send(url.clone(), self.http.post(&url).json(&body))
+            .await
+    }
+
+    /// `POST /v1/sessions/{id}/step`, with its round-trip time in ms.
+    pub async fn step(
+        &self,
+        session: &str,
+        req: &StepRequest,
+    ) -> Result<(StepResponse, f64), ClientError> {
+        let url = format!("{}/v1/sessions/{session}/step", self.base);
+        let started = Instant::now();
+        let resp = self
+            .send(url.clone(), self.http.post(&url).json(req))
+            .await?;
+        Ok((resp, started.elapsed().as_secs_f64() * 1e3))
+    }
+
+    /// `DELETE /v1/sessions/{id}`.
+    pub async fn close_session(&self, session: &str) -> Result<(), ClientError> {
+        let url = format!("{}/v1/sessions/{session}", self.base);
+        let resp =
+            self.http
+                .delete(&url)
+                .send()
+                .await
+                .map_err(|source| ClientError::Transport {
+                    url: url.clone(),
+                    source,
+                })?;
+        if resp.status().is_success() {
+            Ok(())
+        } else {
+            Err(ClientError::Status {
+                url,
+                status: resp.status().as_u16(),
+                body: resp.text().await.unwrap_or_default(),
+            })
+        }
     }
 }
 

@@ -21,6 +21,7 @@ use rand::{SeedableRng, rngs::StdRng};
 use vigil::geometry::Point;
 use vigil::planner::{Id, PlanRequest, PlanResponse, PositionIn, SensorIn, TargetIn};
 use vigil::scenario::{Cell, Scenario};
+use vigil::session::{SessionSettings, StepRequest};
 use vigil::world::World;
 
 use crate::metrics::StepCount;
@@ -343,17 +344,7 @@ impl Sim {
         let s = &self.scenario;
         let settings = policy.planner();
         let centre = |c: Cell| s.centre(c);
-        let sensors = self
-            .sensors
-            .iter()
-            .enumerate()
-            .map(|(i, &c)| SensorIn {
-                id: Id::Number(i.into()),
-                x: centre(c).x,
-                y: centre(c).y,
-                sensor_type: self.type_name(i),
-            })
-            .collect();
+        let sensors = self.plan_request_sensors();
         let clairvoyant = policy == Policy::Clairvoyant;
         let oldest = self.step.saturating_sub(self.history_len);
         let targets = self
@@ -400,6 +391,77 @@ impl Sim {
             // server applies the scenario's.
             min_separation: self.min_separation.map(Into::into),
         }
+    }
+
+    /// The targets detected this step (by any sensor), with their ids,
+    /// positions and velocities: what a session step reports. The
+    /// clairvoyant policy reports every target in the zone.
+    pub fn detected_targets(&self, policy: Policy) -> Vec<TargetIn> {
+        let clairvoyant = policy == Policy::Clairvoyant;
+        let detected: HashSet<u64> = self
+            .now
+            .iter()
+            .filter(|&&(_, _, n)| n > 0)
+            .map(|&(id, _, _)| id)
+            .collect();
+        self.world
+            .in_zone(&self.scenario)
+            .filter(|t| clairvoyant || detected.contains(&t.id))
+            .map(|t| TargetIn {
+                id: Some(Id::Number(t.id.into())),
+                x: t.pos.x,
+                y: t.pos.y,
+                vx: t.vel.x,
+                vy: t.vel.y,
+            })
+            .collect()
+    }
+
+    /// The session step of a planner policy: the sensors now (as in
+    /// [`Sim::plan_request`]) and [`Sim::detected_targets`]. The session
+    /// keeps the history and the tracks, so its plan is the plan of
+    /// [`Sim::plan_request`] when every step of the run, warm-up included,
+    /// went through it.
+    pub fn step_request(&self, policy: Policy, horizon: Option<usize>) -> StepRequest {
+        StepRequest {
+            sensors: self.plan_request_sensors(),
+            detections: self.detected_targets(policy),
+            horizon: horizon.map(Into::into),
+            ..StepRequest::default()
+        }
+    }
+
+    /// The settings of a session that plans for `policy` with `history`
+    /// steps of history, as [`Sim::plan_request`] does.
+    pub fn session_settings(
+        &self,
+        policy: Policy,
+        horizon: Option<usize>,
+        history: usize,
+    ) -> SessionSettings {
+        let settings = policy.planner();
+        SessionSettings {
+            horizon: horizon.map(Into::into),
+            estimator: settings.map(|p| p.estimator),
+            coordination: settings.map(|p| p.coordination),
+            observed: settings.map(|p| p.observed),
+            min_separation: self.min_separation.map(Into::into),
+            history_steps: Some(history.into()),
+        }
+    }
+
+    fn plan_request_sensors(&self) -> Vec<SensorIn> {
+        let s = &self.scenario;
+        self.sensors
+            .iter()
+            .enumerate()
+            .map(|(i, &c)| SensorIn {
+                id: Id::Number(i.into()),
+                x: s.centre(c).x,
+                y: s.centre(c).y,
+                sensor_type: self.type_name(i),
+            })
+            .collect()
     }
 
     /// The minimum separation in force, cells: [`Sim::min_separation`] or

@@ -46,6 +46,10 @@ pub struct RunConfig {
     /// when set); the local policies keep it through
     /// [`crate::policy::keep_apart`].
     pub min_separation: Option<usize>,
+    /// Planner policies plan through a session (`POST /v1/sessions/…/step`,
+    /// every step of the run, warm-up included) instead of stateless plan
+    /// requests; the plans, and so the metrics, are the same.
+    pub session: bool,
 }
 
 impl RunConfig {
@@ -53,6 +57,18 @@ impl RunConfig {
     /// stationary state while the sensors watched from their starting
     /// cells, building tracks and history; the measured window starts now.
     pub fn warmed_up(&self, seed: u64) -> Sim {
+        let mut sim = self.fresh(seed);
+        for _ in 0..self.warmup {
+            sim.observe();
+            let stay = sim.sensors.clone();
+            sim.advance(stay);
+        }
+        sim.start_window();
+        sim
+    }
+
+    /// The run of `seed` before its warm-up.
+    pub fn fresh(&self, seed: u64) -> Sim {
         let mut sim = Sim::with_types(
             self.scenario.clone(),
             self.types(),
@@ -61,12 +77,6 @@ impl RunConfig {
             self.history,
         );
         sim.min_separation = self.min_separation;
-        for _ in 0..self.warmup {
-            sim.observe();
-            let stay = sim.sensors.clone();
-            sim.advance(stay);
-        }
-        sim.start_window();
         sim
     }
 }
@@ -105,13 +115,43 @@ pub async fn run_one(
     seed: u64,
     keep: bool,
 ) -> Result<(Metrics, Option<Sim>), RunError> {
-    let mut sim = cfg.warmed_up(seed);
+    let planner = cfg.policy.planner().is_some();
+    let session = cfg.session && planner;
+    let (mut sim, session) = if session {
+        // The session must see every step, the warm-up's too, to hold the
+        // history and tracks the stateless requests would carry.
+        let mut sim = cfg.fresh(seed);
+        let settings = sim.session_settings(cfg.policy, cfg.horizon, cfg.history);
+        let id = client.open_session(&cfg.scenario_id, &settings).await?.id;
+        for _ in 0..cfg.warmup {
+            sim.observe();
+            client
+                .step(&id, &sim.step_request(cfg.policy, cfg.horizon))
+                .await?;
+            let stay = sim.sensors.clone();
+            sim.advance(stay);
+        }
+        sim.start_window();
+        (sim, Some(id))
+    } else {
+        (cfg.warmed_up(seed), None)
+    };
     let mut acc = RunAccumulator::default();
     for _ in 0..cfg.steps {
         sim.observe();
-        let (next, predicted) = if cfg.policy.planner().is_some() {
-            let req = sim.plan_request(cfg.policy, cfg.horizon);
-            let (resp, ms) = client.plan(&cfg.scenario_id, &req).await?;
+        let (next, predicted) = if planner {
+            let (resp, ms) = match &session {
+                Some(id) => {
+                    let (resp, ms) = client
+                        .step(id, &sim.step_request(cfg.policy, cfg.horizon))
+                        .await?;
+                    (resp.plan, ms)
+                }
+                None => {
+                    let req = sim.plan_request(cfg.policy, cfg.horizon);
+                    client.plan(&cfg.scenario_id, &req).await?
+                }
+            };
             acc.add_plan_time(ms);
             acc.add_plan_violations(
                 resp.separation_violations,
@@ -127,6 +167,9 @@ pub async fn run_one(
         if let Some(p) = predicted {
             acc.add_calibration(p, count.detected);
         }
+    }
+    if let Some(id) = &session {
+        client.close_session(id).await?;
     }
     let metrics = acc.finish(sim.detected_once());
     Ok((metrics, keep.then_some(sim)))

@@ -79,6 +79,11 @@ struct Args {
     /// Where the sensors start.
     #[arg(long, value_enum, default_value_t = Start::Grid)]
     start: Start,
+    /// Plan through sessions (`POST /v1/sessions/{id}/step`: the server
+    /// keeps the history and the tracks) instead of stateless requests; the
+    /// plans and metrics are the same.
+    #[arg(long)]
+    session: bool,
     /// A running vigil-server (e.g. http://127.0.0.1:8080); by default one
     /// is started in-process.
     #[arg(long)]
@@ -177,6 +182,7 @@ async fn run(args: Args) -> Result<(), String> {
         history: args.history.into(),
         start: args.start,
         min_separation: args.min_separation.map(usize::from),
+        session: args.session,
     };
     let configs = match &args.experiment {
         Some(name) => {

@@ -119,6 +119,7 @@ async fn live_view_in_headless_chromium() {
         history: 16,
         start: Start::Grid,
         min_separation: None,
+        session: false,
     };
     let listener = tokio::net::TcpListener::bind("127.0.0.1:0")
         .await

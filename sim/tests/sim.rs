@@ -169,6 +169,7 @@ async fn end_to_end_over_http() {
             history: 4,
             start: Start::Grid,
             min_separation: None,
+            session: false,
         })
         .collect();
     let rows = run_all(&client, &configs, 7, 2, 4).await.expect("runs");
@@ -285,6 +286,7 @@ async fn fleets_move_within_their_speeds_around_no_go_zones() {
         history: 4,
         start: Start::Grid,
         min_separation: None,
+        session: false,
     };
     let (metrics, sim) = run_one(&client, &cfg, 5, true).await.expect("run");
     let sim = sim.expect("kept");

@@ -77,6 +77,13 @@ pub struct Config {
     /// refused with 422 before any work starts (0: no limit).
     #[arg(long, env = "VIGIL_MAX_PLAN_MS", default_value_t = 2_000)]
     pub max_plan_ms: u64,
+    /// A session without a request for this many seconds is dropped.
+    #[arg(long, env = "VIGIL_SESSION_TTL_S", default_value_t = 600)]
+    pub session_ttl_s: u64,
+    /// Most sessions held at once; past it the least recently used is
+    /// dropped.
+    #[arg(long, env = "VIGIL_MAX_SESSIONS", default_value_t = 10_000)]
+    pub max_sessions: usize,
 }
 
 impl Config {
@@ -111,6 +118,10 @@ pub struct Settings {
     pub precompute_queue: usize,
     /// Most predicted CPU milliseconds of one plan (`None`: no limit).
     pub max_plan_ms: Option<f64>,
+    /// Idle time to live of a session.
+    pub session_ttl: Duration,
+    /// Most sessions held at once.
+    pub max_sessions: usize,
 }
 
 impl Settings {
@@ -136,6 +147,8 @@ impl Default for Settings {
             precompute_jobs: 1,
             precompute_queue: 16,
             max_plan_ms: Some(2000.0),
+            session_ttl: Duration::from_secs(600),
+            max_sessions: 10_000,
         }
     }
 }
@@ -157,6 +170,8 @@ impl From<&Config> for Settings {
             precompute_jobs: c.precompute_jobs.max(1),
             precompute_queue: c.precompute_queue,
             max_plan_ms: (c.max_plan_ms > 0).then_some(c.max_plan_ms as f64),
+            session_ttl: Duration::from_secs(c.session_ttl_s.max(1)),
+            max_sessions: c.max_sessions.max(1),
         }
     }
 }

@@ -75,6 +75,16 @@ pub enum ApiError {
     /// A request-level bound other than a field's. 422.
     #[error("{0}")]
     Unprocessable(String),
+    /// No session has this id (never created, expired or evicted). 404.
+    #[error(
+        "no session with id `{id}`: it was never created, or was dropped after {ttl_s} s idle or to make room; create a new one with POST /v1/sessions"
+    )]
+    SessionNotFound {
+        /// The id asked for.
+        id: String,
+        /// The sessions' idle time to live, seconds.
+        ttl_s: u64,
+    },
     /// The scenario is still being precomputed. 503 with Retry-After.
     #[error("scenario `{id}` is still {}; retry in about {} s", if status.queue_position.is_some() { "queued for precomputation" } else { "precomputing" }, status.retry_after_s())]
     ScenarioNotReady {
@@ -146,6 +156,7 @@ impl ApiError {
             ApiError::MalformedBody(_) | ApiError::BadPath(_) => StatusCode::BAD_REQUEST,
             ApiError::PayloadTooLarge(_) => StatusCode::PAYLOAD_TOO_LARGE,
             ApiError::ScenarioNotFound(_)
+            | ApiError::SessionNotFound { .. }
             | ApiError::RouteNotFound(_)
             | ApiError::SensorTypeNotFound { .. } => StatusCode::NOT_FOUND,
             ApiError::BadQuery(_) => StatusCode::BAD_REQUEST,
@@ -184,6 +195,7 @@ impl ApiError {
             ApiError::Overloaded => ("overloaded", "Service overloaded"),
             ApiError::Timeout => ("timeout", "Request timed out"),
             ApiError::Unprocessable(_) => ("validation", "Invalid request"),
+            ApiError::SessionNotFound { .. } => ("session-not-found", "Session not found"),
             ApiError::ScenarioNotReady { .. } => ("scenario-not-ready", "Scenario not ready"),
             ApiError::QueueFull { .. } => ("precompute-queue-full", "Precompute queue full"),
             ApiError::PlanTooCostly { .. } => ("plan-too-costly", "Plan too costly"),

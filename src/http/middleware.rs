@@ -86,7 +86,7 @@ pub async fn track(mut req: Request, next: Next) -> Response {
     let res = next.run(req).await;
     metrics::gauge!("vigil_http_requests_in_flight").decrement(1.0);
     let status = res.status().as_u16().to_string();
-    if route.ends_with("/plan") {
+    if route.ends_with("/plan") || route.ends_with("/step") {
         metrics::histogram!("vigil_plan_duration_seconds", "route" => route.clone())
             .record(started.elapsed().as_secs_f64());
     }

@@ -15,6 +15,11 @@
 //! | DELETE | `/v1/scenarios/{id}` | 204 |
 //! | GET | `/v1/scenarios/{id}/stats` | 200 per-cell statistics |
 //! | POST | `/v1/scenarios/{id}/plan` | 200 [`PlanResponse`](crate::planner::PlanResponse) |
+//! | POST | `/v1/plan` | 200 plan (scenario by id or inline) |
+//! | POST | `/v1/sessions` | 201 session |
+//! | GET | `/v1/sessions/{id}` | 200 session |
+//! | DELETE | `/v1/sessions/{id}` | 204 |
+//! | POST | `/v1/sessions/{id}/step` | 200 plan and step number |
 
 /// The rules of a scenario spec that no JSON Schema can state, for the
 /// operations' descriptions (the fuzzer's list is `.ci/schemathesis/hooks.py`).
@@ -50,6 +55,7 @@ pub mod plan;
 pub mod registry;
 pub mod scenarios;
 pub mod serve;
+pub mod sessions;
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, OnceLock};
@@ -174,6 +180,8 @@ pub struct AppState {
     pub registry: Arc<Registry>,
     /// Planners of scenarios planned inline (`POST /v1/plan`).
     pub cache: Arc<PlannerCache>,
+    /// Step-by-step clients' sessions.
+    pub sessions: Arc<sessions::SessionStore>,
     /// Limits, keys and CORS.
     pub settings: Arc<Settings>,
 }
@@ -198,6 +206,10 @@ impl AppState {
         Self {
             registry: Arc::new(registry),
             cache: Arc::new(PlannerCache::new(settings.cache_bytes)),
+            sessions: Arc::new(sessions::SessionStore::new(
+                settings.session_ttl,
+                settings.max_sessions,
+            )),
             settings: Arc::new(settings),
         }
     }
@@ -239,6 +251,12 @@ pub fn router(state: AppState) -> Router {
         .route("/v1/scenarios/{id}/stats", get(scenarios::stats))
         .route("/v1/scenarios/{id}/plan", post(plan::plan))
         .route("/v1/plan", post(plan::plan_inline))
+        .route("/v1/sessions", post(sessions::create))
+        .route(
+            "/v1/sessions/{id}",
+            get(sessions::get).delete(sessions::delete),
+        )
+        .route("/v1/sessions/{id}/step", post(sessions::step))
         .layer(
             ServiceBuilder::new()
                 .layer(HandleErrorLayer::new(middleware::overload_error))

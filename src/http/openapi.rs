@@ -17,7 +17,7 @@ use utoipa::{Modify, OpenApi, ToResponse, ToSchema};
 
 use super::error::{ApiError, Problem};
 use super::registry::JobStatus;
-use super::{health, middleware, plan, scenarios};
+use super::{health, middleware, plan, scenarios, sessions};
 use crate::coordination::Coordination;
 use crate::planner::{
     EstimatorKind, MAX_HISTORY_POSITIONS, Observed, PositionIn, SensorIn, TargetIn,
@@ -61,6 +61,10 @@ Every error is an RFC 9457 problem (`application/problem+json`, schema \
         scenarios::stats,
         plan::plan,
         plan::plan_inline,
+        sessions::create,
+        sessions::step,
+        sessions::get,
+        sessions::delete,
     ),
     components(
         schemas(Problem),
@@ -73,6 +77,8 @@ Every error is an RFC 9457 problem (`application/problem+json`, schema \
             InvalidScenario,
             InvalidPlanRequest,
             InvalidInlinePlanRequest,
+            InvalidSession,
+            SessionNotFound,
             Unauthorized,
             Overloaded,
             NotReady,
@@ -85,6 +91,7 @@ Every error is an RFC 9457 problem (`application/problem+json`, schema \
         (name = "health", description = "Liveness."),
         (name = "scenarios", description = "Register, read and delete scenarios."),
         (name = "planning", description = "Plan sensors' paths."),
+        (name = "sessions", description = "Plan step by step: the server keeps the history and the tracks."),
         (name = "meta", description = "This document and the server's metrics."),
     )
 )]
@@ -259,6 +266,62 @@ pub enum InlinePlanRequest {
     WithScenario(PlanRequestWithScenario),
 }
 
+macro_rules! session_request_with {
+    ($(#[$doc:meta])* $name:ident, $(#[$field_doc:meta])* $field:ident: $ty:ty) => {
+        $(#[$doc])*
+        #[derive(Debug, ToSchema)]
+        #[serde(deny_unknown_fields)]
+        pub struct $name {
+            $(#[$field_doc])*
+            pub $field: $ty,
+            /// Horizon T of its steps; the scenario's by default.
+            #[schema(value_type = Option<u32>, minimum = 1, maximum = 12)]
+            pub horizon: Option<Integer>,
+            /// Estimator of its steps; `exact` by default.
+            pub estimator: Option<EstimatorKind>,
+            /// Coordination of its steps; `priority` by default.
+            pub coordination: Option<Coordination>,
+            /// What the detections cover; `sensors` by default.
+            pub observed: Option<Observed>,
+            /// Minimum separation of its steps, cells (0..=16); the
+            /// scenario's by default.
+            #[schema(value_type = Option<u32>, minimum = 0, maximum = 16)]
+            pub min_separation: Option<Integer>,
+            /// Steps of history kept (0..=32, 16 by default): the sensors'
+            /// past positions planned with, and how long a track lives
+            /// undetected.
+            #[schema(value_type = Option<u32>, minimum = 0, maximum = 32)]
+            pub history_steps: Option<Integer>,
+        }
+    };
+}
+
+session_request_with!(
+    /// `POST /v1/sessions` naming its scenario.
+    SessionRequestById,
+    /// Id of a registered scenario, or of one sent inline before.
+    #[schema(example = "paper-v10")]
+    scenario_id: String
+);
+
+session_request_with!(
+    /// `POST /v1/sessions` carrying its scenario.
+    SessionRequestWithScenario,
+    /// The scenario itself; precomputed on first use and cached.
+    scenario: ScenarioSpec
+);
+
+/// Body of `POST /v1/sessions`: exactly one of `scenario_id` and
+/// `scenario`, and the defaults of the session's steps.
+#[derive(Debug, ToSchema)]
+#[serde(untagged)]
+pub enum CreateSessionRequest {
+    /// The scenario by id.
+    ById(SessionRequestById),
+    /// The scenario inline.
+    WithScenario(SessionRequestWithScenario),
+}
+
 /// What the derives cannot say and the server enforces: the variants of
 /// `FovSpec` admit no other fields, and a history step holds at most
 /// [`MAX_HISTORY_POSITIONS`] positions.
@@ -365,6 +428,32 @@ pub struct PayloadTooLarge(pub Problem);
     example = json!(problem(ApiError::ScenarioNotFound("nope".to_owned())))
 )]
 pub struct ScenarioNotFound(pub Problem);
+
+/// No session has this id: it was never created, or it was dropped (idle
+/// past the time to live, or evicted to make room). Create a new one.
+#[derive(Debug, ToResponse)]
+#[response(
+    content_type = "application/problem+json",
+    example = json!(problem(ApiError::SessionNotFound { id: "ss-0c5d2f6e8a9b4c3d9e7f1a2b3c4d5e6f".to_owned(), ttl_s: 600 }))
+)]
+pub struct SessionNotFound(pub Problem);
+
+/// A session's defaults are out of bounds, or the body gives both or
+/// neither of `scenario_id` and `scenario`, or its inline scenario is
+/// invalid or too large to precompute synchronously.
+#[derive(Debug, ToResponse)]
+#[response(
+    content_type = "application/problem+json",
+    examples(
+        ("history-steps" = (summary = "Too much history", value = json!(invalid(
+            "history_steps", "must be an integer in 0..=32, got 40"
+        )))),
+        ("one-of" = (summary = "Neither scenario_id nor scenario", value = json!(problem(
+            ApiError::Unprocessable("exactly one of `scenario_id` and `scenario` is required".to_owned())
+        )))),
+    )
+)]
+pub struct InvalidSession(pub Problem);
 
 /// The scenario is built in and cannot be deleted.
 #[derive(Debug, ToResponse)]
@@ -734,6 +823,70 @@ pub mod examples {
             "expected_detections": 19.0996,
             "expected_by_step": [4.808, 6.538, 7.7535],
             "compute_micros": 335
+        })
+    }
+
+    /// A session on `paper-v10` keeping 16 steps of history.
+    pub fn session_request() -> Value {
+        json!({"scenario_id": "paper-v10", "horizon": 3, "history_steps": 16})
+    }
+
+    /// The session of [`session_request`] after the steps of
+    /// [`step_request`] and a second with the sensors moved on.
+    pub fn session_info() -> Value {
+        json!({
+            "id": "ss-36c3f1f5ddc745349553d4bb0bc86f98",
+            "scenario": "paper-v10",
+            "step": 2,
+            "history_steps": 16,
+            "history_held": 2,
+            "settings": {"horizon": 3, "history_steps": 16},
+            "tracks": [
+                {"id": 17, "x": 70.0, "y": 40.0, "vx": 10.0, "vy": 0.0, "last_detected": 0}
+            ],
+            "memory_bytes": 456
+        })
+    }
+
+    /// A step: two sensors, one target detected.
+    pub fn step_request() -> Value {
+        json!({
+            "sensors": [{"id": "a", "x": 55.0, "y": 55.0}, {"id": "b", "x": 245.0, "y": 60.0}],
+            "detections": [{"id": 17, "x": 60.0, "y": 40.0, "vx": 10.0, "vy": 0.0}]
+        })
+    }
+
+    /// The plan of [`step_request`] as the first step of a session.
+    pub fn step_response() -> Value {
+        json!({
+            "step": 0,
+            "scenario": "paper-v10",
+            "horizon": 3,
+            "estimator": "exact",
+            "coordination": "priority",
+            "min_separation": 0,
+            "separation_violations": 0,
+            "plans": [
+                {
+                    "sensor": "a",
+                    "priority": 1,
+                    "start": cell(5, 5),
+                    "path": [cell(6, 4), cell(7, 3), cell(8, 2)],
+                    "expected_detections": 6.9058,
+                    "separation_violations": 0
+                },
+                {
+                    "sensor": "b",
+                    "priority": 2,
+                    "start": cell(24, 6),
+                    "path": [cell(25, 7), cell(26, 8), cell(27, 9)],
+                    "expected_detections": 4.1472,
+                    "separation_violations": 0
+                }
+            ],
+            "expected_detections": 11.053,
+            "expected_by_step": [2.3726, 3.833, 4.8474],
+            "compute_micros": 1560
         })
     }
 }

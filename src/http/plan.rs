@@ -75,13 +75,13 @@ impl Drop for CancelOnDrop {
 
 /// Validates `req`, refuses it if its predicted cost is above the limit,
 /// and plans it on rayon, cancelled as soon as nobody waits for it.
-async fn plan_on_rayon(
+pub(super) async fn plan_on_rayon(
     state: &AppState,
     start: Option<Extension<RequestStart>>,
     planner: Arc<Planner>,
-    req: PlanRequest,
+    req: &PlanRequest,
 ) -> Result<PlanResponse, ApiError> {
-    let input = PlanInput::new(&planner.scenario, &req)?;
+    let input = PlanInput::new(&planner.scenario, req)?;
     if let Some(limit_ms) = state.settings.max_plan_ms {
         let predicted_ms = cost::plan_ms(&planner, &input);
         if predicted_ms > limit_ms {
@@ -143,7 +143,7 @@ pub async fn plan(
 ) -> Result<Json<PlanResponse>, ApiError> {
     let planner = state.registry.ready(&id)?;
     let Json(req) = body?;
-    Ok(Json(plan_on_rayon(&state, start, planner, req).await?))
+    Ok(Json(plan_on_rayon(&state, start, planner, &req).await?))
 }
 
 /// `POST /v1/plan`: the body of `/v1/scenarios/{id}/plan` plus either
@@ -192,9 +192,23 @@ pub async fn plan_inline(
     let inline = fields.remove("scenario");
     let req: PlanRequest = serde_json::from_value(serde_json::Value::Object(fields))
         .map_err(|e| ApiError::MalformedBody(e.to_string()))?;
-    let planner: Arc<Planner> = match (scenario_id, inline) {
+    let planner = resolve_scenario(&state, start, scenario_id, inline).await?;
+    Ok(Json(plan_on_rayon(&state, start, planner, &req).await?))
+}
+
+/// The planner of the scenario a body names: `scenario_id` (registered,
+/// 503 while pending, or cached inline) or `scenario` (an inline spec,
+/// precomputed and cached on first use; 422 above the synchronous budget).
+/// Exactly one of the two is required.
+pub(super) async fn resolve_scenario(
+    state: &AppState,
+    start: Option<Extension<RequestStart>>,
+    scenario_id: Option<serde_json::Value>,
+    inline: Option<serde_json::Value>,
+) -> Result<Arc<Planner>, ApiError> {
+    Ok(match (scenario_id, inline) {
         (Some(serde_json::Value::String(id)), None) => {
-            registered_or_cached(&state, &id)?.ok_or(ApiError::ScenarioNotFound(id))?
+            registered_or_cached(state, &id)?.ok_or(ApiError::ScenarioNotFound(id))?
         }
         (Some(_), None) => {
             return Err(ApiError::MalformedBody(
@@ -208,7 +222,7 @@ pub async fn plan_inline(
                 e.field = format!("scenario.{}", e.field);
                 e
             })?;
-            match registered_or_cached(&state, &scenario.id)? {
+            match registered_or_cached(state, &scenario.id)? {
                 Some(p) => p,
                 None => {
                     let predicted_ms = predicted_precompute_ms(&scenario);
@@ -220,7 +234,7 @@ pub async fn plan_inline(
                         });
                     }
                     let cache = state.cache.clone();
-                    let guard = CancelOnDrop::new("precompute", start, &state);
+                    let guard = CancelOnDrop::new("precompute", start, state);
                     let token = guard.token();
                     let planner = tokio::task::spawn_blocking(move || {
                         precompute_cancellable(scenario, &token, &Progress::default())
@@ -238,8 +252,7 @@ pub async fn plan_inline(
                 "exactly one of `scenario_id` and `scenario` is required".into(),
             ));
         }
-    };
-    Ok(Json(plan_on_rayon(&state, start, planner, req).await?))
+    })
 }
 
 /// A registered scenario's planner (503 while it is pending), else a cached

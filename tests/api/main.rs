@@ -15,3 +15,4 @@ mod ops;
 mod plan;
 mod scenarios;
 mod separation;
+mod sessions;

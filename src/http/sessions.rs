@@ -1,0 +1,328 @@
+//! `/v1/sessions`: step-by-step clients. A session keeps its client's
+//! history and tracks ([`crate::session`]); each step sends only the
+//! sensors now and the detections now.
+//!
+//! Sessions live in this replica's memory, bounded by an idle time to live
+//! and a count (least recently used evicted first); expired sessions are
+//! dropped at the next session request. Steps of one session run one at a
+//! time, in arrival order.
+
+use std::sync::{Arc, Mutex, PoisonError};
+use std::time::{Duration, Instant};
+
+use axum::Extension;
+use axum::extract::State;
+use axum::http::{HeaderValue, StatusCode, header};
+use axum::response::{IntoResponse, Response};
+use lru::LruCache;
+use serde::{Deserialize, Serialize};
+use utoipa::ToSchema;
+
+use super::AppState;
+use super::error::ApiError;
+use super::extract::{Json, Path};
+use super::middleware::RequestStart;
+use super::openapi::{self as doc, examples};
+use super::plan::{plan_on_rayon, resolve_scenario};
+use crate::planner::PlanResponse;
+use crate::scenario::MAX_HORIZON;
+use crate::separation::MAX_MIN_SEPARATION;
+use crate::session::{Session, SessionSettings, StepRequest, Track};
+
+type Shared = Arc<tokio::sync::Mutex<Session>>;
+
+/// The sessions of this replica: an LRU map bounded by count and idle time.
+#[derive(Debug)]
+pub struct SessionStore {
+    inner: Mutex<LruCache<String, (Shared, Instant)>>,
+    ttl: Duration,
+    capacity: usize,
+}
+
+impl SessionStore {
+    /// A store of at most `capacity` sessions, each dropped after `ttl`
+    /// without a request.
+    pub fn new(ttl: Duration, capacity: usize) -> Self {
+        Self {
+            inner: Mutex::new(LruCache::unbounded()),
+            ttl,
+            capacity: capacity.max(1),
+        }
+    }
+
+    /// The idle time to live.
+    pub fn ttl(&self) -> Duration {
+        self.ttl
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, LruCache<String, (Shared, Instant)>> {
+        // Every critical section is a single map operation: poisoning
+        // cannot leave it half-updated.
+        self.inner.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    /// Drops the sessions idle longer than the time to live: the least
+    /// recently used come first, so only the expired are visited.
+    fn sweep(&self, map: &mut LruCache<String, (Shared, Instant)>, now: Instant) {
+        while let Some((_, (_, used))) = map.peek_lru() {
+            if now.duration_since(*used) <= self.ttl {
+                break;
+            }
+            map.pop_lru();
+            metrics::counter!("vigil_sessions_evicted_total", "reason" => "idle").increment(1);
+        }
+        metrics::gauge!("vigil_sessions_live").set(map.len() as f64);
+    }
+
+    /// Keeps a new session under a fresh id, evicting the least recently
+    /// used past the capacity.
+    pub fn insert(&self, session: Session) -> (String, Shared) {
+        let id = format!("ss-{}", uuid::Uuid::new_v4().simple());
+        let shared = Arc::new(tokio::sync::Mutex::new(session));
+        let now = Instant::now();
+        let mut map = self.lock();
+        self.sweep(&mut map, now);
+        while map.len() >= self.capacity {
+            map.pop_lru();
+            metrics::counter!("vigil_sessions_evicted_total", "reason" => "capacity").increment(1);
+        }
+        map.put(id.clone(), (shared.clone(), now));
+        metrics::gauge!("vigil_sessions_live").set(map.len() as f64);
+        (id, shared)
+    }
+
+    /// A live session, marked as used now.
+    ///
+    /// # Errors
+    /// [`ApiError::SessionNotFound`] for an unknown, expired or evicted id.
+    pub fn get(&self, id: &str) -> Result<Shared, ApiError> {
+        let now = Instant::now();
+        let mut map = self.lock();
+        self.sweep(&mut map, now);
+        match map.get_mut(id) {
+            Some((session, used)) => {
+                *used = now;
+                Ok(session.clone())
+            }
+            None => Err(self.not_found(id)),
+        }
+    }
+
+    /// Removes a session.
+    ///
+    /// # Errors
+    /// [`ApiError::SessionNotFound`] for an unknown, expired or evicted id.
+    pub fn remove(&self, id: &str) -> Result<(), ApiError> {
+        let mut map = self.lock();
+        self.sweep(&mut map, Instant::now());
+        let removed = map.pop(id).map(|_| ()).ok_or_else(|| self.not_found(id));
+        metrics::gauge!("vigil_sessions_live").set(map.len() as f64);
+        removed
+    }
+
+    fn not_found(&self, id: &str) -> ApiError {
+        ApiError::SessionNotFound {
+            id: id.to_owned(),
+            ttl_s: self.ttl.as_secs(),
+        }
+    }
+}
+
+/// A session, as `POST /v1/sessions` and `GET /v1/sessions/{id}` return it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
+pub struct SessionInfo {
+    /// Session id.
+    pub id: String,
+    /// Its scenario's id.
+    pub scenario: String,
+    /// Steps made so far: the number of the next step.
+    pub step: u64,
+    /// Steps of history kept.
+    pub history_steps: usize,
+    /// Steps of history held now.
+    pub history_held: usize,
+    /// The defaults of its steps.
+    pub settings: SessionSettings,
+    /// The targets it follows after the last step.
+    pub tracks: Vec<Track>,
+    /// Approximate memory it holds, bytes (the scenario's statistics,
+    /// shared, aside).
+    pub memory_bytes: usize,
+}
+
+impl SessionInfo {
+    fn of(id: String, s: &Session) -> Self {
+        Self {
+            id,
+            scenario: s.planner().scenario.id.clone(),
+            step: s.step(),
+            history_steps: s.history_len(),
+            history_held: s.history_held(),
+            settings: s.settings().clone(),
+            tracks: s.tracks().to_vec(),
+            memory_bytes: s.memory_bytes(),
+        }
+    }
+}
+
+/// Body of `POST /v1/sessions/{id}/step`: the plan, and the step's number.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
+pub struct StepResponse {
+    /// The number of this step (0 for the first).
+    pub step: u64,
+    /// The plan, as `POST /v1/scenarios/{id}/plan` gives it.
+    #[serde(flatten)]
+    pub plan: PlanResponse,
+}
+
+/// `POST /v1/sessions` → 201 [`SessionInfo`] with `Location`.
+#[utoipa::path(
+    post,
+    path = "/v1/sessions",
+    operation_id = "createSession",
+    tag = "sessions",
+    summary = "Open a session",
+    description = "Opens a session for a client that plans every step: the server keeps the \
+        sensors' past positions and the targets' tracks, so each step sends only the sensors \
+        now and the targets detected now. The body names the scenario (`scenario_id`, or an \
+        inline `scenario` as in `POST /v1/plan`) and the defaults of its steps; \
+        `history_steps` (0..=32, 16 by default) is how many steps of history it keeps. \
+        Sessions live in this replica's memory: route a session's requests to the replica \
+        that created it, or use the stateless endpoints. A session idle for `--session-ttl-s` \
+        (600 s), or the least recently used past `--max-sessions` (10 000), is dropped.",
+    request_body(content = doc::CreateSessionRequest, description = "Scenario and defaults.",
+        example = json!(examples::session_request())),
+    responses(
+        (status = 201, description = "The new session.", body = SessionInfo,
+            headers(("Location" = String, description = "`/v1/sessions/{id}`.")),
+            example = json!(examples::session_info())),
+        (status = 400, response = doc::MalformedBody),
+        (status = 404, response = doc::ScenarioNotFound),
+        (status = 413, response = doc::PayloadTooLarge),
+        (status = 422, response = doc::InvalidSession),
+        (status = 503, response = doc::NotReady),
+    )
+)]
+pub async fn create(
+    State(state): State<AppState>,
+    start: Option<Extension<RequestStart>>,
+    Json(body): Json<serde_json::Value>,
+) -> Result<Response, ApiError> {
+    let serde_json::Value::Object(mut fields) = body else {
+        return Err(ApiError::MalformedBody(
+            "the body must be a JSON object".into(),
+        ));
+    };
+    let scenario_id = fields.remove("scenario_id");
+    let inline = fields.remove("scenario");
+    let settings: SessionSettings = serde_json::from_value(serde_json::Value::Object(fields))
+        .map_err(|e| ApiError::MalformedBody(e.to_string()))?;
+    settings.history_len()?;
+    if let Some(h) = &settings.horizon {
+        h.check("horizon", 1..=MAX_HORIZON)?;
+    }
+    if let Some(d) = &settings.min_separation {
+        d.check("min_separation", 0..=MAX_MIN_SEPARATION)?;
+    }
+    let planner = resolve_scenario(&state, start, scenario_id, inline).await?;
+    let session = Session::new(planner, settings);
+    let (id, shared) = state.sessions.insert(session);
+    let info = SessionInfo::of(id.clone(), &*shared.lock().await);
+    let location = HeaderValue::try_from(format!("/v1/sessions/{id}"))
+        .map_err(|e| ApiError::Internal(format!("bad Location header: {e}")))?;
+    Ok((
+        StatusCode::CREATED,
+        [(header::LOCATION, location)],
+        Json(info),
+    )
+        .into_response())
+}
+
+/// `POST /v1/sessions/{id}/step` → 200 [`StepResponse`].
+#[utoipa::path(
+    post,
+    path = "/v1/sessions/{id}/step",
+    operation_id = "stepSession",
+    tag = "sessions",
+    summary = "Plan the next step of a session",
+    description = concat!("Records this step and plans from the session's state. The session moves \
+        every track one step along its straight line, takes each detection as its track's new \
+        state (matched by `id`, else by position and velocity, else a new track), drops the \
+        tracks that left the zone or were not detected for `history_steps` steps, and plans \
+        from the sensors now, the tracks and the sensors' positions over the last \
+        `history_steps` steps: the same plan as the stateless request of that state. Only a \
+        step whose plan is made is recorded, so a step that failed (4xx, 5xx) may be sent \
+        again. Steps of one session run one at a time.", plan_rules!()),
+    params(("id" = String, Path, description = "Session id, from `POST /v1/sessions`.")),
+    request_body(content = StepRequest, description = "Sensors and detections now.",
+        example = json!(examples::step_request())),
+    responses(
+        (status = 200, description = "The plan of this step.", body = StepResponse,
+            example = json!(examples::step_response())),
+        (status = 400, response = doc::MalformedBody),
+        (status = 404, response = doc::SessionNotFound),
+        (status = 413, response = doc::PayloadTooLarge),
+        (status = 422, response = doc::InvalidPlanRequest),
+    )
+)]
+pub async fn step(
+    State(state): State<AppState>,
+    start: Option<Extension<RequestStart>>,
+    Path(id): Path<String>,
+    body: Result<Json<StepRequest>, ApiError>,
+) -> Result<Json<StepResponse>, ApiError> {
+    let shared = state.sessions.get(&id)?;
+    let Json(req) = body?;
+    let mut session = shared.lock().await;
+    let prepared = session.prepare(&req);
+    let plan = plan_on_rayon(&state, start, session.planner().clone(), &prepared.request).await?;
+    let step = session.step();
+    session.commit(prepared);
+    Ok(Json(StepResponse { step, plan }))
+}
+
+/// `GET /v1/sessions/{id}` → 200 [`SessionInfo`].
+#[utoipa::path(
+    get,
+    path = "/v1/sessions/{id}",
+    operation_id = "getSession",
+    tag = "sessions",
+    summary = "Read a session",
+    params(("id" = String, Path, description = "Session id, from `POST /v1/sessions`.")),
+    responses(
+        (status = 200, description = "The session.", body = SessionInfo,
+            example = json!(examples::session_info())),
+        (status = 400, response = doc::BadPath),
+        (status = 404, response = doc::SessionNotFound),
+    )
+)]
+pub async fn get(
+    State(state): State<AppState>,
+    Path(id): Path<String>,
+) -> Result<Json<SessionInfo>, ApiError> {
+    let shared = state.sessions.get(&id)?;
+    let session = shared.lock().await;
+    Ok(Json(SessionInfo::of(id, &session)))
+}
+
+/// `DELETE /v1/sessions/{id}` → 204.
+#[utoipa::path(
+    delete,
+    path = "/v1/sessions/{id}",
+    operation_id = "deleteSession",
+    tag = "sessions",
+    summary = "Close a session",
+    params(("id" = String, Path, description = "Session id, from `POST /v1/sessions`.")),
+    responses(
+        (status = 204, description = "Closed."),
+        (status = 400, response = doc::BadPath),
+        (status = 404, response = doc::SessionNotFound),
+    )
+)]
+pub async fn delete(
+    State(state): State<AppState>,
+    Path(id): Path<String>,
+) -> Result<StatusCode, ApiError> {
+    state.sessions.remove(&id)?;
+    Ok(StatusCode::NO_CONTENT)
+}

@@ -1,0 +1,350 @@
+//! Sessions for step-by-step clients: the server keeps what a simulator
+//! would otherwise resend every step (the sensors' past looks and the
+//! targets' tracks) and turns each step into the stateless plan request of
+//! the same state.
+//!
+//! A step gives the sensors now and the targets detected now. The session
+//! then, in this order:
+//! 1. moves every track one step along its straight line (`pos += vel`, as
+//!    targets fly);
+//! 2. takes each detection as the new state of its track: the track with
+//!    its `id`, else (no id) the anonymous track at the same position and
+//!    velocity, else a new track;
+//! 3. drops the tracks that left the zone or were last detected more than
+//!    `history_steps` steps ago;
+//! 4. plans from the sensors now, the tracks, and the sensors' positions
+//!    1, 2, …, `history_steps` steps ago;
+//! 5. once the plan is made, records this step: the sensors' positions
+//!    join the history and the step number advances. A step whose plan is
+//!    not made (invalid, refused, cancelled) changes nothing, so a client
+//!    may send it again.
+//!
+//! That is the rule the simulation client applies to build its stateless
+//! requests, so a session's plan equals the stateless plan of the same run.
+//!
+//! ```
+//! use std::sync::Arc;
+//! use vigil::planner::{Planner, SensorIn, TargetIn, Id};
+//! use vigil::scenario::builtins;
+//! use vigil::session::{Session, SessionSettings, StepRequest};
+//!
+//! let planner = Arc::new(Planner::new(builtins().remove(0)));
+//! let mut session = Session::new(planner.clone(), SessionSettings::default());
+//! let step = StepRequest {
+//!     sensors: vec![SensorIn { id: Id::Text("a".into()), x: 150.0, y: 150.0, sensor_type: None }],
+//!     detections: vec![TargetIn { id: None, x: 160.0, y: 150.0, vx: 10.0, vy: 0.0 }],
+//!     ..StepRequest::default()
+//! };
+//! let next = session.prepare(&step);
+//! let plan = planner.plan_request(&next.request).unwrap();
+//! session.commit(next);
+//! assert_eq!(session.step(), 1);
+//! assert_eq!(session.tracks().len(), 1);
+//! assert_eq!(plan.plans.len(), 1);
+//! ```
+
+use std::collections::VecDeque;
+use std::sync::Arc;
+
+use serde::{Deserialize, Serialize};
+use utoipa::ToSchema;
+
+use crate::coordination::Coordination;
+use crate::geometry::Point;
+use crate::planner::{
+    EstimatorKind, Id, MAX_HISTORY_STEPS, Observed, PlanRequest, Planner, PositionIn, SensorIn,
+    TargetIn,
+};
+use crate::scenario::{Integer, ValidationError};
+
+/// Steps of history a session keeps by default.
+pub const DEFAULT_HISTORY_STEPS: usize = 16;
+
+/// A session's defaults for its steps; a step may override each but
+/// `history_steps`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SessionSettings {
+    /// Horizon T; the scenario's by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<u32>, minimum = 1, maximum = 12)]
+    pub horizon: Option<Integer>,
+    /// Estimator; `exact` by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub estimator: Option<EstimatorKind>,
+    /// Coordination; `priority` by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coordination: Option<Coordination>,
+    /// What the detections cover; `sensors` by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub observed: Option<Observed>,
+    /// Minimum separation between sensors, cells (0..=16); the scenario's
+    /// by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<u32>, minimum = 0, maximum = 16)]
+    pub min_separation: Option<Integer>,
+    /// Steps of history kept (0..=32, 16 by default): the sensors' past
+    /// positions planned with, and how long a track lives undetected.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<u32>, minimum = 0, maximum = 32)]
+    pub history_steps: Option<Integer>,
+}
+
+impl SessionSettings {
+    /// Checks the bounds no other check covers (`history_steps`; the
+    /// others are checked with every step's plan request) and gives the
+    /// history length.
+    ///
+    /// # Errors
+    /// A [`ValidationError`] naming `history_steps`.
+    pub fn history_len(&self) -> Result<usize, ValidationError> {
+        match &self.history_steps {
+            None => Ok(DEFAULT_HISTORY_STEPS),
+            Some(n) => n.check("history_steps", 0..=MAX_HISTORY_STEPS),
+        }
+    }
+}
+
+/// Body of a session's step.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct StepRequest {
+    /// Sensors now.
+    #[schema(min_items = 1, max_items = 256)]
+    pub sensors: Vec<SensorIn>,
+    /// Targets detected this step (by any sensor), their position and
+    /// displacement per step now; with an `id` when the client tracks
+    /// identities.
+    #[serde(default)]
+    #[schema(max_items = 20000)]
+    pub detections: Vec<TargetIn>,
+    /// Horizon T of this step; the session's by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<u32>, minimum = 1, maximum = 12)]
+    pub horizon: Option<Integer>,
+    /// Estimator of this step; the session's by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub estimator: Option<EstimatorKind>,
+    /// Coordination of this step; the session's by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coordination: Option<Coordination>,
+    /// Minimum separation of this step; the session's by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<u32>, minimum = 0, maximum = 16)]
+    pub min_separation: Option<Integer>,
+    /// Include the search values in the response.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub explain: Option<bool>,
+}
+
+/// A target the session follows: its last detection moved on along its
+/// straight line.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
+pub struct Track {
+    /// The id the client gave it, if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub id: Option<Id>,
+    /// East coordinate now.
+    pub x: f64,
+    /// North coordinate now.
+    pub y: f64,
+    /// East displacement per step.
+    pub vx: f64,
+    /// North displacement per step.
+    pub vy: f64,
+    /// The step it was last detected at.
+    pub last_detected: u64,
+}
+
+impl Track {
+    fn target(&self) -> TargetIn {
+        TargetIn {
+            id: self.id.clone(),
+            x: self.x,
+            y: self.y,
+            vx: self.vx,
+            vy: self.vy,
+        }
+    }
+}
+
+/// A step made ready: the stateless request of the session's state with
+/// this step, and the tracks to keep once its plan is made
+/// ([`Session::commit`]).
+#[derive(Debug, Clone)]
+pub struct PreparedStep {
+    /// The equivalent stateless plan request.
+    pub request: PlanRequest,
+    tracks: Vec<Track>,
+}
+
+/// One client's session on one scenario (see the module docs).
+#[derive(Debug)]
+pub struct Session {
+    planner: Arc<Planner>,
+    settings: SessionSettings,
+    history_len: usize,
+    step: u64,
+    /// Sensors' positions 1, 2, … steps ago.
+    history: VecDeque<Vec<PositionIn>>,
+    tracks: Vec<Track>,
+}
+
+impl Session {
+    /// A session at step 0 with no history and no tracks. `settings` must
+    /// have passed [`SessionSettings::history_len`] (an out-of-bounds
+    /// `history_steps` is clamped).
+    pub fn new(planner: Arc<Planner>, settings: SessionSettings) -> Self {
+        let history_len = settings
+            .history_len()
+            .unwrap_or(DEFAULT_HISTORY_STEPS)
+            .min(MAX_HISTORY_STEPS);
+        Self {
+            planner,
+            settings,
+            history_len,
+            step: 0,
+            history: VecDeque::new(),
+            tracks: Vec::new(),
+        }
+    }
+
+    /// The planner of its scenario.
+    pub fn planner(&self) -> &Arc<Planner> {
+        &self.planner
+    }
+
+    /// Its defaults.
+    pub fn settings(&self) -> &SessionSettings {
+        &self.settings
+    }
+
+    /// Steps of history kept.
+    pub fn history_len(&self) -> usize {
+        self.history_len
+    }
+
+    /// Steps made so far (the next step's number).
+    pub fn step(&self) -> u64 {
+        self.step
+    }
+
+    /// The tracks after the last step.
+    pub fn tracks(&self) -> &[Track] {
+        &self.tracks
+    }
+
+    /// Steps of history held now (up to [`Session::history_len`]).
+    pub fn history_held(&self) -> usize {
+        self.history.len()
+    }
+
+    /// Approximate heap memory held, bytes (its planner, shared, aside).
+    pub fn memory_bytes(&self) -> usize {
+        let positions: usize = self
+            .history
+            .iter()
+            .map(|step| {
+                step.capacity() * std::mem::size_of::<PositionIn>()
+                    + step
+                        .iter()
+                        .filter_map(|p| p.sensor_type.as_ref())
+                        .map(String::capacity)
+                        .sum::<usize>()
+            })
+            .sum();
+        std::mem::size_of::<Self>()
+            + self.history.capacity() * std::mem::size_of::<Vec<PositionIn>>()
+            + positions
+            + self.tracks.capacity() * std::mem::size_of::<Track>()
+    }
+
+    /// Steps 1–4 of the module docs: the tracks this step leads to and the
+    /// stateless request of the state, without changing the session.
+    pub fn prepare(&self, step: &StepRequest) -> PreparedStep {
+        let s = &self.planner.scenario;
+        let now = self.step;
+        let mut tracks: Vec<Track> = self
+            .tracks
+            .iter()
+            .map(|t| Track {
+                x: t.x + t.vx,
+                y: t.y + t.vy,
+                ..t.clone()
+            })
+            .collect();
+        // Tracks that existed before this step: an anonymous detection may
+        // only match one of them, not another detection of this step.
+        let before = tracks.len();
+        for d in &step.detections {
+            let detected = Track {
+                id: d.id.clone(),
+                x: d.x,
+                y: d.y,
+                vx: d.vx,
+                vy: d.vy,
+                last_detected: now,
+            };
+            let same = match &d.id {
+                Some(id) => tracks.iter().position(|t| t.id.as_ref() == Some(id)),
+                None => tracks[..before].iter().position(|t| {
+                    t.id.is_none()
+                        && t.last_detected < now
+                        && t.vx == d.vx
+                        && t.vy == d.vy
+                        && (t.x - d.x).abs().max((t.y - d.y).abs()) <= 1e-6 * s.cell_size
+                }),
+            };
+            match same {
+                Some(i) => tracks[i] = detected,
+                None => tracks.push(detected),
+            }
+        }
+        let oldest = now.saturating_sub(self.history_len as u64);
+        tracks.retain(|t| {
+            t.last_detected >= oldest
+                && t.x.is_finite()
+                && t.y.is_finite()
+                && s.in_zone(Point::new(t.x, t.y))
+        });
+        let history: Vec<Vec<PositionIn>> = self.history.iter().cloned().collect();
+        let request = PlanRequest {
+            sensors: step.sensors.clone(),
+            targets: tracks.iter().map(Track::target).collect(),
+            history: (!history.is_empty()).then_some(history),
+            horizon: step
+                .horizon
+                .clone()
+                .or_else(|| self.settings.horizon.clone()),
+            estimator: step.estimator.or(self.settings.estimator),
+            coordination: step.coordination.or(self.settings.coordination),
+            observed: self.settings.observed,
+            explain: step.explain,
+            min_separation: step
+                .min_separation
+                .clone()
+                .or_else(|| self.settings.min_separation.clone()),
+        };
+        PreparedStep { request, tracks }
+    }
+
+    /// Step 5 of the module docs: records a step whose plan was made.
+    pub fn commit(&mut self, prepared: PreparedStep) {
+        if self.history_len > 0 {
+            let looks = prepared
+                .request
+                .sensors
+                .iter()
+                .map(|s| PositionIn {
+                    x: s.x,
+                    y: s.y,
+                    sensor_type: s.sensor_type.clone(),
+                })
+                .collect();
+            self.history.push_front(looks);
+            self.history.truncate(self.history_len);
+        }
+        self.tracks = prepared.tracks;
+        self.step += 1;
+    }
+}
