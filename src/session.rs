@@ -52,8 +52,8 @@ use utoipa::ToSchema;
 use crate::coordination::Coordination;
 use crate::geometry::Point;
 use crate::planner::{
-    EstimatorKind, Id, MAX_HISTORY_STEPS, Observed, PlanRequest, Planner, PositionIn, SensorIn,
-    TargetIn,
+    EstimatorKind, Id, MAX_HISTORY_STEPS, MAX_TARGETS, Observed, PlanRequest, Planner, PositionIn,
+    SensorIn, TargetIn,
 };
 use crate::scenario::{Integer, ValidationError};
 
@@ -135,6 +135,37 @@ pub struct StepRequest {
     /// Include the search values in the response.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub explain: Option<bool>,
+}
+
+impl StepRequest {
+    /// Checks what the plan request built from it cannot name: the number
+    /// of detections and their numbers (the sensors are checked with the
+    /// plan request, under their own names).
+    ///
+    /// # Errors
+    /// A [`ValidationError`] naming `detections` or `detections[i].x` (…).
+    pub fn check(&self) -> Result<(), ValidationError> {
+        if self.detections.len() > MAX_TARGETS {
+            return Err(ValidationError::new(
+                "detections",
+                format!(
+                    "at most {MAX_TARGETS} detections, got {}",
+                    self.detections.len()
+                ),
+            ));
+        }
+        for (i, d) in self.detections.iter().enumerate() {
+            for (name, v) in [("x", d.x), ("y", d.y), ("vx", d.vx), ("vy", d.vy)] {
+                if !v.is_finite() {
+                    return Err(ValidationError::new(
+                        format!("detections[{i}].{name}"),
+                        "must be a finite number",
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// A target the session follows: its last detection moved on along its
@@ -346,5 +377,115 @@ impl Session {
         }
         self.tracks = prepared.tracks;
         self.step += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::builtins;
+
+    fn session(history: usize) -> Session {
+        let planner = Arc::new(Planner::new(builtins().remove(0)));
+        Session::new(
+            planner,
+            SessionSettings {
+                history_steps: Some(history.into()),
+                ..SessionSettings::default()
+            },
+        )
+    }
+
+    fn step(detections: Vec<TargetIn>) -> StepRequest {
+        StepRequest {
+            sensors: vec![SensorIn {
+                id: Id::Text("a".into()),
+                x: 150.0,
+                y: 150.0,
+                sensor_type: None,
+            }],
+            detections,
+            ..StepRequest::default()
+        }
+    }
+
+    fn anonymous(x: f64, y: f64, vx: f64) -> TargetIn {
+        TargetIn {
+            id: None,
+            x,
+            y,
+            vx,
+            vy: 0.0,
+        }
+    }
+
+    #[test]
+    fn anonymous_detections_continue_their_tracks_and_tracks_expire() {
+        let mut s = session(2);
+        let first = s.prepare(&step(vec![
+            anonymous(100.0, 50.0, 10.0),
+            anonymous(200.0, 80.0, -5.0),
+        ]));
+        s.commit(first);
+        // The first target again where its track says; a new one elsewhere.
+        let second = s.prepare(&step(vec![
+            anonymous(110.0, 50.0, 10.0),
+            anonymous(20.0, 20.0, 1.0),
+        ]));
+        assert_eq!(second.request.targets.len(), 3);
+        s.commit(second);
+        let detected_at: Vec<u64> = s.tracks().iter().map(|t| t.last_detected).collect();
+        assert_eq!(detected_at, [1, 0, 1]);
+        // Undetected for more than 2 steps: the second target's track goes.
+        s.commit(s.prepare(&step(vec![])));
+        assert_eq!(s.tracks().len(), 3);
+        s.commit(s.prepare(&step(vec![])));
+        assert_eq!(s.tracks().len(), 2);
+        assert!(s.tracks().iter().all(|t| t.last_detected == 1));
+        // Positions moved on one step at a time.
+        assert_eq!((s.tracks()[0].x, s.tracks()[0].y), (130.0, 50.0));
+        assert_eq!(s.history_held(), 2);
+        assert_eq!(s.step(), 4);
+    }
+
+    #[test]
+    fn two_anonymous_detections_at_one_place_are_two_targets() {
+        let s = session(4);
+        let prepared = s.prepare(&step(vec![
+            anonymous(100.0, 50.0, 1.0),
+            anonymous(100.0, 50.0, 1.0),
+        ]));
+        assert_eq!(prepared.request.targets.len(), 2);
+    }
+
+    #[test]
+    fn tracks_leaving_the_zone_are_dropped() {
+        let mut s = session(16);
+        s.commit(s.prepare(&step(vec![anonymous(295.0, 50.0, 10.0)])));
+        assert_eq!(s.tracks().len(), 1);
+        s.commit(s.prepare(&step(vec![])));
+        assert!(s.tracks().is_empty());
+    }
+
+    #[test]
+    fn bad_detections_are_named() {
+        let mut req = step(vec![anonymous(1.0, f64::NAN, 0.0)]);
+        let e = req.check().unwrap_err();
+        assert_eq!(e.field, "detections[0].y");
+        req.detections = vec![anonymous(1.0, 1.0, 0.0); MAX_TARGETS + 1];
+        assert_eq!(req.check().unwrap_err().field, "detections");
+    }
+
+    #[test]
+    fn history_steps_is_bounded() {
+        let settings = SessionSettings {
+            history_steps: Some(33usize.into()),
+            ..SessionSettings::default()
+        };
+        assert_eq!(settings.history_len().unwrap_err().field, "history_steps");
+        assert_eq!(
+            SessionSettings::default().history_len(),
+            Ok(DEFAULT_HISTORY_STEPS)
+        );
     }
 }

@@ -426,7 +426,7 @@ impl Registry {
 
     fn check_room(&self) -> Result<(), ApiError> {
         let state = self.read();
-        let free_slot = state.running.len() < state.limits.jobs && state.queue.is_empty();
+        let free_slot = state.running.len() < state.limits.jobs.max(1) && state.queue.is_empty();
         if !free_slot && state.queue.len() >= state.limits.queue {
             let wait: f64 = state.running.iter().map(|j| j.remaining_s()).sum::<f64>()
                 / state.limits.jobs.max(1) as f64;

@@ -24,8 +24,8 @@ use super::extract::{Json, Path};
 use super::middleware::RequestStart;
 use super::openapi::{self as doc, examples};
 use super::plan::{plan_on_rayon, resolve_scenario};
-use crate::planner::PlanResponse;
-use crate::scenario::MAX_HORIZON;
+use crate::planner::{MAX_TARGETS, PlanResponse};
+use crate::scenario::{MAX_HORIZON, ValidationError};
 use crate::separation::MAX_MIN_SEPARATION;
 use crate::session::{Session, SessionSettings, StepRequest, Track};
 
@@ -273,8 +273,19 @@ pub async fn step(
 ) -> Result<Json<StepResponse>, ApiError> {
     let shared = state.sessions.get(&id)?;
     let Json(req) = body?;
+    req.check()?;
     let mut session = shared.lock().await;
     let prepared = session.prepare(&req);
+    if prepared.request.targets.len() > MAX_TARGETS {
+        return Err(ValidationError::new(
+            "detections",
+            format!(
+                "the session would follow {} targets, at most {MAX_TARGETS}",
+                prepared.request.targets.len()
+            ),
+        )
+        .into());
+    }
     let plan = plan_on_rayon(&state, start, session.planner().clone(), &prepared.request).await?;
     let step = session.step();
     session.commit(prepared);

@@ -85,6 +85,14 @@ async fn a_session_records_steps_and_plans_as_the_stateless_request() {
     assert_eq!(info["tracks"][0]["last_detected"], 0);
     assert!(info["memory_bytes"].as_u64().unwrap() > 0);
 
+    // Bad detections are named as such.
+    let far = json!({"sensors": sensors(10.0),
+        "detections": (0..20_001).map(|i| json!({"x": 1.0, "y": f64::from(i) * 0.01, "vx": 0.0, "vy": 0.0})).collect::<Vec<_>>()});
+    let res = app
+        .post_json(&format!("/v1/sessions/{id}/step"), &far)
+        .await;
+    assert_validation(res, "detections").await;
+
     // A step that fails records nothing: the step may be sent again.
     let outside = json!({"sensors": [{"id": "a", "x": 400.0, "y": 10.0}]});
     let res = app
