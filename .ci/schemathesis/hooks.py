@@ -5,9 +5,11 @@ The `positive_data_acceptance` check (a request the document calls valid must
 not be refused) is replaced by `schema_valid_requests_are_accepted`, which is
 the same check except that a 422 whose problem `detail` matches one of the
 rules below is accepted: the request was schema-valid but broke a documented
-rule that the schema cannot express. Everything else (any 5xx, a status,
-content type or body the document does not describe, a schema-invalid
-request accepted) is checked by Schemathesis's own checks.
+rule that the schema cannot express. `not_a_server_error` is replaced by
+`no_server_error_but_retry_later`, which accepts the documented 503s that
+say when to retry. Everything else (any other 5xx, a status, content type
+or body the document does not describe, a schema-invalid request accepted)
+is checked by Schemathesis's own checks.
 """
 
 import re
@@ -79,6 +81,18 @@ UNSCHEMATISABLE = [
         r"^sensors\[\d+\]\.id: duplicate sensor id",
         "uniqueness of one property across array items (uniqueItems compares whole items)",
     ),
+    (
+        r"^this plan is predicted to take .* above this server's limit",
+        "a bound on the plan's predicted cost, a function of every field (src/cost.rs)",
+    ),
+    (
+        r"^scenario: its precomputation is predicted to take .* synchronous budget",
+        "a bound on the inline scenario's predicted precompute time (src/cost.rs)",
+    ),
+    (
+        r"^detections: the session would follow \d+ targets",
+        "a bound on the session's tracks: this step's detections plus those kept from earlier steps",
+    ),
 ]
 
 _RULES = [re.compile(pattern) for pattern, _ in UNSCHEMATISABLE]
@@ -101,3 +115,28 @@ def schema_valid_requests_are_accepted(ctx, response, case):
         if isinstance(detail, str) and documented_refusal(detail):
             return None
     return positive_data_acceptance(ctx, response, case)
+
+
+# 503s the document describes, each telling the client when to retry
+# (`Retry-After`): shed under load, a scenario still being precomputed by
+# its job, a full job queue. They are answers, not server errors.
+RETRY_LATER = ("/overloaded", "/scenario-not-ready", "/precompute-queue-full")
+
+
+@schemathesis.check
+def no_server_error_but_retry_later(ctx, response, case):
+    """No 5xx, except a documented 503 that says when to retry."""
+    if response.status_code < 500:
+        return None
+    if response.status_code == 503 and "retry-after" in {
+        k.lower() for k in response.headers
+    }:
+        try:
+            kind = response.json().get("type", "")
+        except ValueError:
+            kind = ""
+        if isinstance(kind, str) and kind.endswith(RETRY_LATER):
+            return None
+    raise AssertionError(
+        f"Server error: {response.status_code} {response.text[:300]}"
+    )

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Fuzzes a release vigil-server on a loopback port with Schemathesis, driven
-# by the server's own OpenAPI document, and fails on any 5xx, any response
+# by the server's own OpenAPI document, and fails on any 5xx (but a documented
+# 503 with Retry-After, see hooks.py), any response
 # the document does not describe (status, content type, body schema), any
 # schema-invalid request accepted, and any schema-valid request refused
 # except for the rules listed in .ci/schemathesis/hooks.py.
@@ -49,7 +50,7 @@ fi
 SCHEMATHESIS_HOOKS="$HOOKS" "$VENV/bin/schemathesis" run \
     "http://$address/openapi.json" \
     --checks all \
-    --exclude-checks positive_data_acceptance \
+    --exclude-checks positive_data_acceptance,not_a_server_error \
     --max-examples "$EXAMPLES" \
     --seed "$SEED" \
     --workers 1 \

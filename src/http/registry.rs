@@ -45,14 +45,30 @@ impl Default for JobLimits {
     }
 }
 
-/// The precompute pool: its own threads, so a large scenario's many tasks
-/// do not sit ahead of every plan's on rayon's global pool; the two share
-/// the cores through the OS scheduler instead.
-fn pool() -> Option<&'static rayon::ThreadPool> {
-    static POOL: OnceLock<Option<rayon::ThreadPool>> = OnceLock::new();
-    POOL.get_or_init(|| {
+/// Which pool a precomputation runs on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Pool {
+    /// Registrations answered when done (and inline scenarios).
+    Sync,
+    /// Background jobs.
+    Jobs,
+}
+
+/// The precompute pools: threads of their own, so a large scenario's many
+/// tasks do not sit ahead of every plan's on rayon's global pool; they
+/// share the cores through the OS scheduler instead. Jobs have a pool
+/// apart from synchronous registrations: in one pool, a small
+/// registration's work would queue behind every block of a running job.
+fn pool(which: Pool) -> Option<&'static rayon::ThreadPool> {
+    static SYNC: OnceLock<Option<rayon::ThreadPool>> = OnceLock::new();
+    static JOBS: OnceLock<Option<rayon::ThreadPool>> = OnceLock::new();
+    let (cell, name) = match which {
+        Pool::Sync => (&SYNC, "vigil-precompute"),
+        Pool::Jobs => (&JOBS, "vigil-job"),
+    };
+    cell.get_or_init(|| {
         rayon::ThreadPoolBuilder::new()
-            .thread_name(|i| format!("vigil-precompute-{i}"))
+            .thread_name(move |i| format!("{name}-{i}"))
             .build()
             .map_err(|e| tracing::warn!(error = %e, "no precompute pool; using the global one"))
             .ok()
@@ -64,7 +80,8 @@ fn pool() -> Option<&'static rayon::ThreadPool> {
 /// milliseconds: the model's CPU time ([`cost::precompute_ms`]) shared by
 /// the pool's threads (the work splits evenly over blocks of cells).
 pub fn predicted_precompute_ms(s: &Scenario) -> f64 {
-    let threads = pool().map_or_else(rayon::current_num_threads, |p| p.current_num_threads());
+    let threads =
+        pool(Pool::Sync).map_or_else(rayon::current_num_threads, |p| p.current_num_threads());
     cost::precompute_ms(s) / threads.max(1) as f64
 }
 
@@ -86,7 +103,16 @@ pub fn precompute_cancellable(
     cancel: &CancelToken,
     progress: &Progress,
 ) -> Result<Planner, Cancelled> {
-    let planner = match pool() {
+    precompute_on(Pool::Sync, scenario, cancel, progress)
+}
+
+fn precompute_on(
+    which: Pool,
+    scenario: Scenario,
+    cancel: &CancelToken,
+    progress: &Progress,
+) -> Result<Planner, Cancelled> {
+    let planner = match pool(which) {
         Some(pool) => pool.install(|| Planner::precompute(scenario, cancel, progress)),
         None => Planner::precompute(scenario, cancel, progress),
     }?;
@@ -474,7 +500,7 @@ impl Registry {
         let id = job.scenario.id.clone();
         tracing::info!(%id, predicted_ms = job.predicted_ms, "precompute job started");
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            precompute_cancellable(job.scenario.clone(), &job.cancel, &job.progress)
+            precompute_on(Pool::Jobs, job.scenario.clone(), &job.cancel, &job.progress)
         }));
         {
             let mut state = self.write();

@@ -426,3 +426,27 @@ async fn a_synchronous_registration_nobody_waits_for_stops_and_is_not_stored() {
     drop(server);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A running job does not hold up a small registration: jobs have a pool
+/// of their own, and the small one is answered while the job goes on.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_small_registration_is_not_queued_behind_a_job() {
+    let app = spawn_with(Settings {
+        sync_precompute_ms: 50.0,
+        ..Settings::default()
+    })
+    .await;
+    let (path, _) = accepted(&app.address, &circles(600, 0.34)).await;
+    wait_progress(&app.address, &path, 0.05).await;
+    let sent = Instant::now();
+    let res = app
+        .post_json("/v1/scenarios", &crate::helpers::small_spec())
+        .await;
+    let took = sent.elapsed();
+    let body = json_body(res, StatusCode::CREATED).await;
+    assert_eq!(body["status"], "ready");
+    let job = status(&app.address, &path).await;
+    assert_eq!(job["status"], "precomputing", "the job ended first: {job}");
+    assert!(took < Duration::from_secs(1), "201 after {took:?}");
+    assert_eq!(app.delete(&path).await.status(), StatusCode::NO_CONTENT);
+}
