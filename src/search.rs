@@ -777,10 +777,20 @@ fn programme<S: Score>(grid: &ValueGrid) -> BestPath {
             violations += u32::from(k);
         }
     }
-    BestPath {
-        moves,
-        violations: if value.is_some() { violations } else { 0 },
-        value: value.unwrap_or(f64::NEG_INFINITY),
+    match value {
+        Some(value) => BestPath {
+            moves,
+            violations,
+            value,
+        },
+        // No path from the start: the walk above may have stepped onto a
+        // later step's values through cells with none. Stay put, as
+        // documented (and as brute force answers).
+        None => BestPath {
+            moves: vec![(0, 0); h],
+            violations: 0,
+            value: f64::NEG_INFINITY,
+        },
     }
 }
 
