@@ -76,7 +76,12 @@ fn main() -> ExitCode {
     }
     drop(runtime);
     drop(cluster);
-    let _ = std::fs::remove_dir_all(server::log_dir());
+    // The servers' logs are kept when a test failed.
+    if failed.is_empty() {
+        let _ = std::fs::remove_dir_all(server::log_dir());
+    } else {
+        println!("servers' logs: {}", server::log_dir().display());
+    }
     println!(
         "\ndatabase tests: {} passed, {} failed, {:.1} s",
         selected.len() - failed.len(),
