@@ -64,7 +64,8 @@ pub struct Config {
     #[arg(long, env = "VIGIL_REQUEST_TIMEOUT_MS", default_value_t = 30_000)]
     pub request_timeout_ms: u64,
     /// Memory for statistics of scenarios planned inline through /v1/plan,
-    /// MiB (least recently used are evicted).
+    /// MiB (least recently used are evicted); with --database-url, as much
+    /// again for the registered scenarios this replica uses.
     #[arg(long, env = "VIGIL_CACHE_MB", default_value_t = 512)]
     pub cache_mb: u64,
     /// A connection that has not sent a whole request head within this
