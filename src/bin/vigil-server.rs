@@ -2,6 +2,8 @@
 //!
 //! ```text
 //! vigil-server --help            every option, each with an environment variable
+//! vigil-server --database-url postgres://… --import-dir DIR
+//!                                loads a data directory into the database, then exits
 //! ```
 //!
 //! Logs go to stderr, filtered by `RUST_LOG` (default `info`). The server
@@ -10,7 +12,7 @@
 
 use std::io::IsTerminal;
 use std::process::ExitCode;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use clap::Parser;
 use tokio::net::TcpListener;
@@ -18,6 +20,10 @@ use tracing_subscriber::EnvFilter;
 use vigil::http::config::{Config, LogFormat};
 use vigil::http::serve::serve;
 use vigil::http::{AppState, router};
+use vigil::store::{PgStore, Store};
+
+/// How long a start waits for an unreachable database before giving up.
+const DATABASE_WAIT: Duration = Duration::from_secs(30);
 
 #[tokio::main]
 async fn main() -> ExitCode {
@@ -32,7 +38,26 @@ async fn main() -> ExitCode {
     }
 
     let started = Instant::now();
-    let state = {
+    let database = match config.database() {
+        Some(url) => match PgStore::connect(url, config.database_timeout(), DATABASE_WAIT).await {
+            Ok(store) => Some(store),
+            Err(e) => {
+                tracing::error!(error = %e, "cannot use the database");
+                return ExitCode::FAILURE;
+            }
+        },
+        None => None,
+    };
+    if let Some(dir) = &config.import_dir {
+        let Some(store) = database else {
+            tracing::error!("--import-dir needs --database-url");
+            return ExitCode::FAILURE;
+        };
+        return import(&store, dir).await;
+    }
+    let state = if let Some(store) = database {
+        AppState::from_database(&config, store)
+    } else {
         let owned = config.clone();
         match tokio::task::spawn_blocking(move || AppState::from_config(&owned)).await {
             Ok(Ok(state)) => state,
@@ -46,12 +71,19 @@ async fn main() -> ExitCode {
             }
         }
     };
-    tracing::info!(
-        elapsed_ms = started.elapsed().as_secs_f64() * 1e3,
-        scenarios = state.registry.list().len(),
-        data_dir = %config.data_dir.display(),
-        "scenarios ready"
-    );
+    if config.database().is_some() {
+        tracing::info!(
+            elapsed_ms = started.elapsed().as_secs_f64() * 1e3,
+            "scenarios kept in the database; each is precomputed here on first use"
+        );
+    } else {
+        tracing::info!(
+            elapsed_ms = started.elapsed().as_secs_f64() * 1e3,
+            scenarios = state.registry.list().len(),
+            data_dir = %config.data_dir.display(),
+            "scenarios ready"
+        );
+    }
 
     let listener = match TcpListener::bind(config.bind).await {
         Ok(listener) => listener,
@@ -76,6 +108,43 @@ async fn main() -> ExitCode {
     }
     tracing::info!("shut down");
     ExitCode::SUCCESS
+}
+
+/// `--import-dir`: loads the valid scenarios of a data directory into the
+/// database (corrupt files are logged and skipped, as on a start).
+async fn import(store: &PgStore, dir: &std::path::Path) -> ExitCode {
+    if !dir.is_dir() {
+        tracing::error!(dir = %dir.display(), "no such data directory");
+        return ExitCode::FAILURE;
+    }
+    let owned = dir.to_path_buf();
+    let scenarios = match tokio::task::spawn_blocking(move || Store::open(&owned)).await {
+        Ok(Ok((_, scenarios))) => scenarios,
+        Ok(Err(e)) => {
+            tracing::error!(dir = %dir.display(), error = %e, "cannot read the data directory");
+            return ExitCode::FAILURE;
+        }
+        Err(e) => {
+            tracing::error!(error = %e, "failed to read the data directory");
+            return ExitCode::FAILURE;
+        }
+    };
+    match store.import(&scenarios).await {
+        Ok(added) => {
+            tracing::info!(
+                dir = %dir.display(),
+                found = scenarios.len(),
+                added,
+                already_there = scenarios.len() - added,
+                "import done"
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            tracing::error!(error = %e, "import failed; running it again resumes it");
+            ExitCode::FAILURE
+        }
+    }
 }
 
 /// Resolves on SIGINT (Ctrl+C) or, on Unix, SIGTERM. If a handler cannot be

@@ -67,6 +67,23 @@ impl PlannerCache {
         planner
     }
 
+    /// Drops the planner of `id`, if held.
+    pub fn remove(&self, id: &str) {
+        let mut inner = self.lock();
+        if let Some(old) = inner.planners.pop(id) {
+            inner.bytes -= old.memory_bytes();
+        }
+    }
+
+    /// The ids of the planners held.
+    pub fn ids(&self) -> Vec<String> {
+        self.lock()
+            .planners
+            .iter()
+            .map(|(id, _)| id.clone())
+            .collect()
+    }
+
     /// Planners held and their bytes.
     pub fn usage(&self) -> (usize, usize) {
         let inner = self.lock();

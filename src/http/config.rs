@@ -25,9 +25,27 @@ pub struct Config {
     /// Address to listen on.
     #[arg(long, env = "VIGIL_BIND", default_value = "127.0.0.1:8080")]
     pub bind: SocketAddr,
-    /// Directory where registered scenarios are kept (created if missing).
+    /// Directory where registered scenarios are kept (created if missing);
+    /// not used with --database-url.
     #[arg(long, env = "VIGIL_DATA_DIR", default_value = "./vigil-data")]
     pub data_dir: PathBuf,
+    /// PostgreSQL URL (`postgres://user:password@host:port/database`). When
+    /// set, registered scenarios are kept in that database, and every
+    /// replica pointed at it serves the same catalogue; the schema is
+    /// migrated at start.
+    #[arg(long, env = "VIGIL_DATABASE_URL", hide_env_values = true)]
+    pub database_url: Option<String>,
+    /// Time limit of one call to the database, milliseconds (waiting for a
+    /// connection included); past it the request gets 503 with Retry-After.
+    /// Keep it well below --request-timeout-ms.
+    #[arg(long, env = "VIGIL_DATABASE_TIMEOUT_MS", default_value_t = 2_000)]
+    pub database_timeout_ms: u64,
+    /// Loads every scenario of this data directory (a file store, as
+    /// --data-dir keeps it) into the database of --database-url, then
+    /// exits. Scenarios already there are left alone: running it twice
+    /// changes nothing.
+    #[arg(long, value_name = "DIR", requires = "database_url")]
+    pub import_dir: Option<PathBuf>,
     /// When set, every /v1 endpoint requires `Authorization: Bearer <key>`.
     #[arg(long, env = "VIGIL_API_KEY", hide_env_values = true)]
     pub api_key: Option<String>,
@@ -46,7 +64,8 @@ pub struct Config {
     #[arg(long, env = "VIGIL_REQUEST_TIMEOUT_MS", default_value_t = 30_000)]
     pub request_timeout_ms: u64,
     /// Memory for statistics of scenarios planned inline through /v1/plan,
-    /// MiB (least recently used are evicted).
+    /// MiB (least recently used are evicted); with --database-url, as much
+    /// again for the registered scenarios this replica uses.
     #[arg(long, env = "VIGIL_CACHE_MB", default_value_t = 512)]
     pub cache_mb: u64,
     /// A connection that has not sent a whole request head within this
@@ -87,6 +106,16 @@ pub struct Config {
 }
 
 impl Config {
+    /// The database URL, if one is set (an empty one is none).
+    pub fn database(&self) -> Option<&str> {
+        self.database_url.as_deref().filter(|u| !u.is_empty())
+    }
+
+    /// The time limit of one call to the database.
+    pub fn database_timeout(&self) -> Duration {
+        Duration::from_millis(self.database_timeout_ms.max(1))
+    }
+
     /// The limits on connections.
     pub fn conn_limits(&self) -> super::serve::ConnLimits {
         super::serve::ConnLimits {

@@ -10,6 +10,9 @@ use utoipa::ToSchema;
 
 use crate::scenario::ValidationError;
 
+/// Seconds a client should wait after [`ApiError::DatabaseUnavailable`].
+pub const DATABASE_RETRY_S: u64 = 2;
+
 /// Media type of error bodies.
 pub const PROBLEM_JSON: &str = "application/problem+json";
 
@@ -122,6 +125,12 @@ pub enum ApiError {
         /// The budget, milliseconds.
         budget_ms: f64,
     },
+    /// The database holding the scenario catalogue (`--database-url`) is
+    /// unreachable or too slow. 503 with Retry-After.
+    #[error(
+        "the scenario catalogue's database cannot be reached; retry in about {DATABASE_RETRY_S} s (plans on built-in, inline and already used scenarios still work)"
+    )]
+    DatabaseUnavailable,
     /// A bug: a background task failed or a response could not be built. 500.
     #[error("internal error: {0}")]
     Internal(String),
@@ -169,9 +178,9 @@ impl ApiError {
             ApiError::Unprocessable(_)
             | ApiError::PlanTooCostly { .. }
             | ApiError::PrecomputeTooCostly { .. } => StatusCode::UNPROCESSABLE_ENTITY,
-            ApiError::ScenarioNotReady { .. } | ApiError::QueueFull { .. } => {
-                StatusCode::SERVICE_UNAVAILABLE
-            }
+            ApiError::ScenarioNotReady { .. }
+            | ApiError::QueueFull { .. }
+            | ApiError::DatabaseUnavailable => StatusCode::SERVICE_UNAVAILABLE,
             ApiError::Internal(_) => StatusCode::INTERNAL_SERVER_ERROR,
         }
     }
@@ -202,6 +211,7 @@ impl ApiError {
             ApiError::PrecomputeTooCostly { .. } => {
                 ("precompute-too-costly", "Scenario too large to plan inline")
             }
+            ApiError::DatabaseUnavailable => ("database-unavailable", "Database unavailable"),
             ApiError::Internal(_) => ("internal", "Internal server error"),
         }
     }
@@ -242,6 +252,9 @@ impl IntoResponse for ApiError {
                     header::RETRY_AFTER,
                     HeaderValue::from(status.retry_after_s()),
                 );
+            }
+            ApiError::DatabaseUnavailable => {
+                headers.insert(header::RETRY_AFTER, HeaderValue::from(DATABASE_RETRY_S));
             }
             ApiError::QueueFull { retry_after_s, .. } => {
                 headers.insert(header::RETRY_AFTER, HeaderValue::from(retry_after_s));

@@ -73,7 +73,7 @@ use tower_http::trace::TraceLayer;
 
 use self::cache::PlannerCache;
 use self::config::{Config, Settings};
-use crate::store::Store;
+use crate::store::{PgStore, Store};
 
 pub use error::{ApiError, Problem};
 pub use registry::{JobLimits, Registry, precompute};
@@ -223,6 +223,18 @@ impl AppState {
             Registry::with_store(store, stored, settings.job_limits()),
             settings,
         ))
+    }
+}
+
+impl AppState {
+    /// State from the server's configuration with scenarios in the
+    /// database `store` (connected and migrated): starts following its
+    /// deletions on the current runtime ([`Registry::watch`]).
+    pub fn from_database(config: &Config, store: PgStore) -> Self {
+        let settings = Settings::from(config);
+        let registry = Registry::with_database(store, settings.job_limits(), settings.cache_bytes);
+        registry.watch();
+        Self::with_settings(registry, settings)
     }
 }
 

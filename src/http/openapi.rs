@@ -547,19 +547,27 @@ pub struct InvalidInlinePlanRequest(pub Problem);
 pub struct Unauthorized(pub Problem);
 
 /// The server is handling as many `/v1` requests as it allows: the request
-/// was shed at once, without being handled. Retry after the delay given.
+/// was shed at once, without being handled; or, with a shared database
+/// (`--database-url`), the database is unreachable and the request needs
+/// it. Retry after the delay given.
 #[derive(Debug, ToResponse)]
 #[response(
     content_type = "application/problem+json",
     headers(("Retry-After" = String, description = "Seconds to wait before retrying.")),
-    example = json!(problem(ApiError::Overloaded))
+    examples(
+        ("overloaded" = (summary = "Shed under load", value = json!(problem(ApiError::Overloaded)))),
+        ("database-unavailable" = (summary = "The scenario database is unreachable",
+            value = json!(problem(ApiError::DatabaseUnavailable)))),
+    )
 )]
 pub struct Overloaded(pub Problem);
 
 /// The server is handling as many `/v1` requests as it allows (shed at
 /// once, without being handled), or the scenario is still being
-/// precomputed (`GET /v1/scenarios/{id}` shows its progress). Retry after
-/// the delay given: for a pending scenario, its estimated time to ready.
+/// precomputed (`GET /v1/scenarios/{id}` shows its progress), or, with a
+/// shared database, the scenario is not held here and the database is
+/// unreachable. Retry after the delay given: for a pending scenario, its
+/// estimated time to ready.
 #[derive(Debug, ToResponse)]
 #[response(
     content_type = "application/problem+json",
@@ -572,13 +580,16 @@ pub struct Overloaded(pub Problem);
             }
         )))),
         ("overloaded" = (summary = "Shed under load", value = json!(problem(ApiError::Overloaded)))),
+        ("database-unavailable" = (summary = "The scenario database is unreachable",
+            value = json!(problem(ApiError::DatabaseUnavailable)))),
     )
 )]
 pub struct NotReady(pub Problem);
 
 /// The server is handling as many `/v1` requests as it allows (shed at
 /// once), or as many precomputation jobs wait as its queue holds
-/// (`--precompute-queue`). Retry after the delay given.
+/// (`--precompute-queue`), or, with a shared database, the database is
+/// unreachable. Retry after the delay given.
 #[derive(Debug, ToResponse)]
 #[response(
     content_type = "application/problem+json",
@@ -588,6 +599,8 @@ pub struct NotReady(pub Problem);
             ApiError::QueueFull { limit: 16, retry_after_s: 40 }
         )))),
         ("overloaded" = (summary = "Shed under load", value = json!(problem(ApiError::Overloaded)))),
+        ("database-unavailable" = (summary = "The scenario database is unreachable",
+            value = json!(problem(ApiError::DatabaseUnavailable)))),
     )
 )]
 pub struct QueueFull(pub Problem);

@@ -141,7 +141,7 @@ pub async fn plan(
     Path(id): Path<String>,
     body: Result<Json<PlanRequest>, ApiError>,
 ) -> Result<Json<PlanResponse>, ApiError> {
-    let planner = state.registry.ready(&id)?;
+    let planner = state.registry.resolve(&id).await?;
     let Json(req) = body?;
     Ok(Json(plan_on_rayon(&state, start, planner, &req).await?))
 }
@@ -207,9 +207,11 @@ pub(super) async fn resolve_scenario(
     inline: Option<serde_json::Value>,
 ) -> Result<Arc<Planner>, ApiError> {
     Ok(match (scenario_id, inline) {
-        (Some(serde_json::Value::String(id)), None) => {
-            registered_or_cached(state, &id)?.ok_or(ApiError::ScenarioNotFound(id))?
-        }
+        (Some(serde_json::Value::String(id)), None) => match registered_or_cached(state, &id)? {
+            Some(planner) => planner,
+            // A registered scenario not used here yet (with a database).
+            None => state.registry.resolve(&id).await?,
+        },
         (Some(_), None) => {
             return Err(ApiError::MalformedBody(
                 "scenario_id must be a string".into(),
@@ -255,8 +257,9 @@ pub(super) async fn resolve_scenario(
     })
 }
 
-/// A registered scenario's planner (503 while it is pending), else a cached
-/// inline one's, else `None`.
+/// A registered scenario's planner held here (503 while it is pending),
+/// else a cached inline one's, else `None`. Never asks the database, so
+/// inline scenarios are served while it is unreachable.
 fn registered_or_cached(state: &AppState, id: &str) -> Result<Option<Arc<Planner>>, ApiError> {
     match state.registry.ready(id) {
         Ok(p) => Ok(Some(p)),

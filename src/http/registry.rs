@@ -10,18 +10,34 @@
 //!
 //! Lifecycle of a scenario: `queued` → `precomputing` → `ready`, or only
 //! `ready` for a synchronous registration.
+//!
+//! Where the registered scenarios are kept ([`crate::store`]):
+//! - With the file store (the default) the registry holds every one, loaded
+//!   at start; the directory is this replica's own.
+//! - With PostgreSQL the database is the catalogue and the registry a cache
+//!   of it: a scenario is read from the database on this replica's first
+//!   request for it and precomputed then (or started as a job if large),
+//!   and its planner is kept in a cache bounded by memory, as inline
+//!   scenarios are. Deletions reach every replica through LISTEN/NOTIFY
+//!   ([`Registry::watch`]); after every (re)connection of the listener the
+//!   held ids are checked against the table, so a notification missed
+//!   during an outage never leaves a deleted scenario served. While the
+//!   database is unreachable, what is held keeps serving, and what needs
+//!   the database answers [`ApiError::DatabaseUnavailable`].
 
 use std::collections::btree_map::Entry as MapEntry;
-use std::collections::{BTreeMap, VecDeque};
-use std::sync::{Arc, OnceLock, PoisonError, RwLock};
+use std::collections::{BTreeMap, HashMap, VecDeque};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex, OnceLock, PoisonError, RwLock};
 use std::time::{Duration, Instant};
 
+use super::cache::PlannerCache;
 use super::error::ApiError;
 use crate::cancel::{CancelToken, Cancelled, Progress};
 use crate::cost;
 use crate::planner::Planner;
 use crate::scenario::{BUILTIN_IDS, Scenario, builtins};
-use crate::store::Store;
+use crate::store::{DbError, PgStore, Store};
 
 /// The bounds on precomputation.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -199,7 +215,50 @@ struct State {
 #[derive(Debug, Default)]
 struct Shared {
     state: RwLock<State>,
+    /// The file store, if scenarios are kept in files.
     store: Option<Store>,
+    /// The database, if scenarios are kept in PostgreSQL.
+    db: Option<Database>,
+}
+
+/// The PostgreSQL catalogue and what this replica holds of it.
+#[derive(Debug)]
+struct Database {
+    store: PgStore,
+    /// Planners of ready registered scenarios used here, bounded by memory
+    /// (pending ones are in the registry's map, with their jobs).
+    cache: PlannerCache,
+    /// Evictions so far: a load that saw this change while it read the
+    /// row checks the row again before keeping the scenario.
+    evictions: AtomicU64,
+    /// One load per id at a time; the others wait and find it held.
+    loading: Mutex<HashMap<String, Arc<tokio::sync::Mutex<()>>>>,
+}
+
+/// One scenario of the catalogue, as [`Registry::catalogue`] lists it.
+#[derive(Debug, Clone)]
+pub enum Listed {
+    /// Held by this replica, in whatever state.
+    Held(Entry, Option<JobStatus>),
+    /// In the database, not (yet) used on this replica.
+    Stored(Box<Scenario>),
+}
+
+/// The problem for a failed call to the database (logged here; the client
+/// is told only to retry).
+pub fn unavailable(e: DbError) -> ApiError {
+    tracing::warn!(error = %e, "the scenario database is unavailable");
+    ApiError::DatabaseUnavailable
+}
+
+/// True for ids that can name a registered scenario (`s-` and 16 hex
+/// digits, see [`crate::scenario`]): others need no database look-up.
+fn derivable(id: &str) -> bool {
+    id.len() == 18
+        && id.starts_with("s-")
+        && id[2..]
+            .bytes()
+            .all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b))
 }
 
 /// The registered scenarios: built-in, registered and ready, or pending
@@ -222,7 +281,29 @@ impl Registry {
             .into_iter()
             .map(|s| (s.id.clone(), Entry::Ready(Arc::new(Planner::new(s)))))
             .collect();
-        Self::from_parts(scenarios, None, JobLimits::default())
+        Self::from_parts(scenarios, None, None, JobLimits::default())
+    }
+
+    /// The built-ins, with registered scenarios in PostgreSQL: read on
+    /// first use, their planners kept in a cache of at most `cache_bytes`.
+    /// Call [`Registry::watch`] from the async runtime to follow deletions.
+    pub fn with_database(store: PgStore, limits: JobLimits, cache_bytes: usize) -> Self {
+        let scenarios = builtins()
+            .into_iter()
+            .map(|s| (s.id.clone(), Entry::Ready(Arc::new(Planner::new(s)))))
+            .collect();
+        let db = Database {
+            store,
+            cache: PlannerCache::new(cache_bytes),
+            evictions: AtomicU64::new(0),
+            loading: Mutex::new(HashMap::new()),
+        };
+        Self::from_parts(scenarios, None, Some(db), limits)
+    }
+
+    /// The database, when scenarios are kept in PostgreSQL.
+    pub fn database(&self) -> Option<&PgStore> {
+        self.shared.db.as_ref().map(|db| &db.store)
     }
 
     /// The built-ins plus the scenarios kept in `store`: those predicted
@@ -245,7 +326,7 @@ impl Registry {
                 .entry(p.scenario.id.clone())
                 .or_insert_with(|| Entry::Ready(Arc::new(p)));
         }
-        let registry = Self::from_parts(scenarios, Some(store), limits);
+        let registry = Self::from_parts(scenarios, Some(store), None, limits);
         {
             let mut state = registry.write();
             for s in later {
@@ -267,6 +348,7 @@ impl Registry {
     fn from_parts(
         scenarios: BTreeMap<String, Entry>,
         store: Option<Store>,
+        db: Option<Database>,
         limits: JobLimits,
     ) -> Self {
         let registry = Self {
@@ -277,6 +359,7 @@ impl Registry {
                     ..State::default()
                 }),
                 store,
+                db,
             }),
         };
         registry.update_gauges(&registry.read());
@@ -317,53 +400,213 @@ impl Registry {
     }
 
     fn update_gauges(&self, state: &State) {
-        metrics::gauge!("vigil_scenarios_loaded").set(state.scenarios.len() as f64);
+        let cached = self.shared.db.as_ref().map_or(0, |db| db.cache.usage().0);
+        metrics::gauge!("vigil_scenarios_loaded").set((state.scenarios.len() + cached) as f64);
         metrics::gauge!("vigil_precompute_jobs", "state" => "queued").set(state.queue.len() as f64);
         metrics::gauge!("vigil_precompute_jobs", "state" => "running")
             .set(state.running.len() as f64);
     }
 
-    /// The planner of a ready scenario.
+    /// The planner of a ready scenario held here.
     pub fn get(&self, id: &str) -> Option<Arc<Planner>> {
-        match self.read().scenarios.get(id)? {
-            Entry::Ready(p) => Some(p.clone()),
-            Entry::Pending(_) => None,
+        match self.entry(id)? {
+            (Entry::Ready(p), _) => Some(p),
+            (Entry::Pending(_), _) => None,
         }
     }
 
-    /// The planner of a scenario to plan with.
+    /// The planner of a scenario held here, to plan with.
     ///
     /// # Errors
-    /// [`ApiError::ScenarioNotFound`] for an unknown id,
+    /// [`ApiError::ScenarioNotFound`] for an id not held here,
     /// [`ApiError::ScenarioNotReady`] while it is pending.
     pub fn ready(&self, id: &str) -> Result<Arc<Planner>, ApiError> {
-        let state = self.read();
-        match state.scenarios.get(id) {
-            Some(Entry::Ready(p)) => Ok(p.clone()),
-            Some(Entry::Pending(job)) => Err(ApiError::ScenarioNotReady {
-                id: id.to_owned(),
-                status: Self::job_status(&state, job),
-            }),
+        match self.entry(id) {
+            Some(found) => Self::planner_of(id, found),
             None => Err(ApiError::ScenarioNotFound(id.to_owned())),
         }
     }
 
-    /// A scenario in whatever state, with its job's status when pending.
-    pub fn entry(&self, id: &str) -> Option<(Entry, Option<JobStatus>)> {
-        let state = self.read();
-        let entry = state.scenarios.get(id)?.clone();
-        let status = Self::status_of(&state, &entry);
-        Some((entry, status))
+    fn planner_of(id: &str, found: (Entry, Option<JobStatus>)) -> Result<Arc<Planner>, ApiError> {
+        match found {
+            (Entry::Ready(p), _) => Ok(p),
+            (Entry::Pending(job), status) => Err(ApiError::ScenarioNotReady {
+                id: id.to_owned(),
+                status: status.unwrap_or(JobStatus {
+                    queue_position: None,
+                    progress: job.progress.fraction(),
+                    eta_s: job.remaining_s(),
+                }),
+            }),
+        }
     }
 
-    /// Every scenario, sorted by id, with its job's status when pending.
+    /// A scenario held here in whatever state, with its job's status when
+    /// pending.
+    pub fn entry(&self, id: &str) -> Option<(Entry, Option<JobStatus>)> {
+        {
+            let state = self.read();
+            if let Some(entry) = state.scenarios.get(id) {
+                let status = Self::status_of(&state, entry);
+                return Some((entry.clone(), status));
+            }
+        }
+        let planner = self.shared.db.as_ref()?.cache.get(id)?;
+        Some((Entry::Ready(planner), None))
+    }
+
+    /// A scenario in whatever state: held here, or (with a database) read
+    /// from it and made ready here, or started as a job if large.
+    ///
+    /// # Errors
+    /// [`ApiError::ScenarioNotFound`] for an unknown id,
+    /// [`ApiError::DatabaseUnavailable`] if it must be read and cannot be.
+    pub async fn lookup(&self, id: &str) -> Result<(Entry, Option<JobStatus>), ApiError> {
+        if let Some(found) = self.entry(id) {
+            return Ok(found);
+        }
+        match &self.shared.db {
+            Some(db) if derivable(id) => self.load(db, id).await,
+            _ => Err(ApiError::ScenarioNotFound(id.to_owned())),
+        }
+    }
+
+    /// The planner of a scenario to plan with, read from the database on a
+    /// miss ([`Registry::lookup`]).
+    ///
+    /// # Errors
+    /// Those of [`Registry::lookup`], and [`ApiError::ScenarioNotReady`]
+    /// while it is pending.
+    pub async fn resolve(&self, id: &str) -> Result<Arc<Planner>, ApiError> {
+        let found = self.lookup(id).await?;
+        Self::planner_of(id, found)
+    }
+
+    /// Reads `id` from the database and makes it ready here (a large one is
+    /// started as a job), one load per id at a time.
+    async fn load(&self, db: &Database, id: &str) -> Result<(Entry, Option<JobStatus>), ApiError> {
+        let lock = db
+            .loading
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .entry(id.to_owned())
+            .or_default()
+            .clone();
+        let result = {
+            let _one = lock.lock().await;
+            match self.entry(id) {
+                Some(found) => Ok(found),
+                None => self.load_now(db, id).await,
+            }
+        };
+        let mut loading = db.loading.lock().unwrap_or_else(PoisonError::into_inner);
+        // Ours and the map's: nobody else waits on this id.
+        if Arc::strong_count(&lock) <= 2 {
+            loading.remove(id);
+        }
+        result
+    }
+
+    async fn load_now(
+        &self,
+        db: &Database,
+        id: &str,
+    ) -> Result<(Entry, Option<JobStatus>), ApiError> {
+        let seen = db.evictions.load(Ordering::SeqCst);
+        let row = db
+            .store
+            .get(id)
+            .await
+            .map_err(unavailable)?
+            .ok_or_else(|| ApiError::ScenarioNotFound(id.to_owned()))?;
+        let scenario = row.scenario;
+        if predicted_precompute_ms(&scenario) > self.limits().sync_precompute_ms {
+            tracing::info!(%id, "a stored scenario is precomputed here as a job");
+            let (entry, _) = self.enqueue(scenario);
+            let status = self.entry(id).and_then(|(_, status)| status);
+            return Ok((entry, status));
+        }
+        let planner = tokio::task::spawn_blocking(move || precompute(scenario)).await?;
+        tracing::info!(%id, precompute_ms = planner.precompute_ms, "loaded a stored scenario");
+        // Deleted while it was read or precomputed: its notification may
+        // have come before it was held, so ask the table again.
+        if db.evictions.load(Ordering::SeqCst) != seen {
+            let present = db
+                .store
+                .existing(&[id.to_owned()])
+                .await
+                .map_err(unavailable)?;
+            if !present.contains(id) {
+                return Err(ApiError::ScenarioNotFound(id.to_owned()));
+            }
+        }
+        Ok((Entry::Ready(self.hold(db, Arc::new(planner))), None))
+    }
+
+    /// Keeps a ready planner of a registered scenario in the database's
+    /// cache; returns the one now held under its id.
+    fn hold(&self, db: &Database, planner: Arc<Planner>) -> Arc<Planner> {
+        let state = self.write();
+        let held = match state.scenarios.get(&planner.scenario.id) {
+            Some(Entry::Ready(p)) => p.clone(),
+            _ => db.cache.insert(planner),
+        };
+        self.update_gauges(&state);
+        held
+    }
+
+    /// Every scenario held here, sorted by id, with its job's status when
+    /// pending.
     pub fn list(&self) -> Vec<(Entry, Option<JobStatus>)> {
-        let state = self.read();
-        state
-            .scenarios
-            .values()
-            .map(|e| (e.clone(), Self::status_of(&state, e)))
-            .collect()
+        let mut held: Vec<(Entry, Option<JobStatus>)> = {
+            let state = self.read();
+            state
+                .scenarios
+                .values()
+                .map(|e| (e.clone(), Self::status_of(&state, e)))
+                .collect()
+        };
+        if let Some(db) = &self.shared.db {
+            for id in db.cache.ids() {
+                if let Some(p) = db.cache.get(&id) {
+                    held.push((Entry::Ready(p), None));
+                }
+            }
+            held.sort_by(|a, b| entry_id(&a.0).cmp(entry_id(&b.0)));
+        }
+        held
+    }
+
+    /// The catalogue, sorted by id: every scenario held here with the file
+    /// store; with a database, the built-ins and every stored scenario,
+    /// as held here or only stored.
+    ///
+    /// # Errors
+    /// [`ApiError::DatabaseUnavailable`] if the database cannot be read.
+    pub async fn catalogue(&self) -> Result<Vec<Listed>, ApiError> {
+        let Some(db) = &self.shared.db else {
+            return Ok(self
+                .list()
+                .into_iter()
+                .map(|(e, s)| Listed::Held(e, s))
+                .collect());
+        };
+        let rows = db.store.list().await.map_err(unavailable)?;
+        let mut listed: Vec<(String, Listed)> = BUILTIN_IDS
+            .iter()
+            .filter_map(|id| self.entry(id))
+            .map(|(e, s)| (entry_id(&e).to_owned(), Listed::Held(e, s)))
+            .collect();
+        for row in rows {
+            let id = row.scenario.id.clone();
+            let item = match self.entry(&id) {
+                Some((e, s)) => Listed::Held(e, s),
+                None => Listed::Stored(Box::new(row.scenario)),
+            };
+            listed.push((id, item));
+        }
+        listed.sort_by(|a, b| a.0.cmp(&b.0));
+        Ok(listed.into_iter().map(|(_, l)| l).collect())
     }
 
     fn status_of(state: &State, entry: &Entry) -> Option<JobStatus> {
@@ -401,37 +644,69 @@ impl Registry {
     }
 
     /// Registers a planner under its scenario's id unless one is already
-    /// there, writing it to the store first (so an acknowledged scenario is
-    /// on disk). Returns the entry now registered under that id and whether
-    /// it is the one passed in. Blocking I/O: call it off the async workers.
-    pub fn insert(&self, planner: Arc<Planner>) -> Result<(Entry, bool), ApiError> {
+    /// there, storing it first (so an acknowledged scenario is durable).
+    /// Returns the entry now registered under that id and whether this call
+    /// created it (with a database: whether it created the row, so the same
+    /// spec registered through two replicas at once is created once).
+    ///
+    /// # Errors
+    /// [`ApiError::Internal`] if the file store fails,
+    /// [`ApiError::DatabaseUnavailable`] if the database does.
+    pub async fn insert(&self, planner: Arc<Planner>) -> Result<(Entry, bool), ApiError> {
         if let Some((existing, _)) = self.entry(&planner.scenario.id) {
             return Ok((existing, false));
         }
-        self.save(&planner.scenario)?;
-        let mut state = self.write();
-        let out = match state.scenarios.entry(planner.scenario.id.clone()) {
-            MapEntry::Occupied(e) => (e.get().clone(), false),
-            MapEntry::Vacant(e) => (e.insert(Entry::Ready(planner)).clone(), true),
-        };
-        self.update_gauges(&state);
-        Ok(out)
+        if let Some(db) = &self.shared.db {
+            let created = db
+                .store
+                .insert(&planner.scenario)
+                .await
+                .map_err(unavailable)?;
+            return Ok((Entry::Ready(self.hold(db, planner)), created));
+        }
+        let registry = self.clone();
+        tokio::task::spawn_blocking(move || {
+            registry.save(&planner.scenario)?;
+            let mut state = registry.write();
+            let out = match state.scenarios.entry(planner.scenario.id.clone()) {
+                MapEntry::Occupied(e) => (e.get().clone(), false),
+                MapEntry::Vacant(e) => (e.insert(Entry::Ready(planner)).clone(), true),
+            };
+            registry.update_gauges(&state);
+            Ok(out)
+        })
+        .await?
     }
 
     /// Accepts a scenario as a precomputation job: stores its spec durably,
     /// queues the job and starts it when a slot is free. Returns the entry
     /// now registered under its id (an existing one wins) and whether it is
-    /// the new job. Blocking I/O: call it off the async workers.
+    /// a new job.
     ///
     /// # Errors
     /// [`ApiError::QueueFull`] when as many jobs wait as the queue holds
-    /// and none could start now; [`ApiError::Internal`] if the store fails.
-    pub fn submit(&self, scenario: Scenario) -> Result<(Entry, bool), ApiError> {
+    /// and none could start now; [`ApiError::Internal`] if the file store
+    /// fails, [`ApiError::DatabaseUnavailable`] if the database does.
+    pub async fn submit(&self, scenario: Scenario) -> Result<(Entry, bool), ApiError> {
         if let Some((existing, _)) = self.entry(&scenario.id) {
             return Ok((existing, false));
         }
         self.check_room()?;
-        self.save(&scenario)?;
+        match &self.shared.db {
+            Some(db) => {
+                db.store.insert(&scenario).await.map_err(unavailable)?;
+            }
+            None => {
+                let registry = self.clone();
+                let copy = scenario.clone();
+                tokio::task::spawn_blocking(move || registry.save(&copy)).await??;
+            }
+        }
+        Ok(self.enqueue(scenario))
+    }
+
+    /// Queues a job for a stored scenario unless its id is held already.
+    fn enqueue(&self, scenario: Scenario) -> (Entry, bool) {
         let job = Arc::new(Job::new(scenario));
         let out = {
             let mut state = self.write();
@@ -447,7 +722,7 @@ impl Registry {
             }
         };
         self.pump();
-        Ok(out)
+        out
     }
 
     fn check_room(&self) -> Result<(), ApiError> {
@@ -464,6 +739,7 @@ impl Registry {
         Ok(())
     }
 
+    /// Writes a scenario to the file store, if there is one. Blocking I/O.
     fn save(&self, scenario: &Scenario) -> Result<(), ApiError> {
         match &self.shared.store {
             Some(store) => store
@@ -510,7 +786,17 @@ impl Registry {
             match result {
                 Ok(Ok(planner)) if current => {
                     tracing::info!(%id, precompute_ms = planner.precompute_ms, predicted_ms = job.predicted_ms, "precompute job done");
-                    state.scenarios.insert(id, Entry::Ready(Arc::new(planner)));
+                    match &self.shared.db {
+                        // Held in the bounded cache, like every registered
+                        // scenario read from the database.
+                        Some(db) => {
+                            db.cache.insert(Arc::new(planner));
+                            state.scenarios.remove(&id);
+                        }
+                        None => {
+                            state.scenarios.insert(id, Entry::Ready(Arc::new(planner)));
+                        }
+                    }
                 }
                 Ok(_) => tracing::info!(%id, "precompute job cancelled"),
                 Err(_) => {
@@ -526,35 +812,159 @@ impl Registry {
         self.pump();
     }
 
-    /// Removes a scenario, from the store too; a pending one's job is
-    /// cancelled at once. Fails with [`ApiError::BuiltinScenario`] for a
-    /// built-in and [`ApiError::ScenarioNotFound`] for an unknown id.
-    /// Blocking I/O.
-    pub fn remove(&self, id: &str) -> Result<Entry, ApiError> {
+    /// Removes a scenario from the store (file or database) and from this
+    /// replica; a pending one's job is cancelled at once.
+    ///
+    /// # Errors
+    /// [`ApiError::BuiltinScenario`] for a built-in,
+    /// [`ApiError::ScenarioNotFound`] for an unknown id,
+    /// [`ApiError::Internal`] if the file store fails and
+    /// [`ApiError::DatabaseUnavailable`] if the database does.
+    pub async fn remove(&self, id: &str) -> Result<(), ApiError> {
         if Self::is_builtin(id) {
             return Err(ApiError::BuiltinScenario(id.to_owned()));
+        }
+        if let Some(db) = &self.shared.db {
+            let existed = derivable(id) && db.store.delete(id).await.map_err(unavailable)?;
+            // Every replica evicts it on the notification; this one at once.
+            self.evict(id);
+            return if existed {
+                Ok(())
+            } else {
+                Err(ApiError::ScenarioNotFound(id.to_owned()))
+            };
         }
         if self.entry(id).is_none() {
             return Err(ApiError::ScenarioNotFound(id.to_owned()));
         }
-        if let Some(store) = &self.shared.store {
-            store
-                .remove(id)
-                .map_err(|e| ApiError::Internal(format!("removing scenario {id}: {e}")))?;
+        let registry = self.clone();
+        let owned = id.to_owned();
+        tokio::task::spawn_blocking(move || {
+            if let Some(store) = &registry.shared.store {
+                store
+                    .remove(&owned)
+                    .map_err(|e| ApiError::Internal(format!("removing scenario {owned}: {e}")))?;
+            }
+            if registry.evict(&owned) {
+                Ok(())
+            } else {
+                Err(ApiError::ScenarioNotFound(owned))
+            }
+        })
+        .await?
+    }
+
+    /// Drops a registered scenario from this replica (not from the store),
+    /// cancelling its job if pending; true if it was held.
+    pub fn evict(&self, id: &str) -> bool {
+        if Self::is_builtin(id) {
+            return false;
         }
         let mut state = self.write();
-        let removed = state
-            .scenarios
-            .remove(id)
-            .ok_or_else(|| ApiError::ScenarioNotFound(id.to_owned()))?;
-        if let Entry::Pending(job) = &removed {
-            job.cancel.cancel();
-            state.queue.retain(|j| !Arc::ptr_eq(j, job));
-            metrics::counter!("vigil_cancelled_total", "kind" => "precompute", "reason" => "deleted")
-                .increment(1);
+        let mut held = false;
+        if let Some(removed) = state.scenarios.remove(id) {
+            held = true;
+            if let Entry::Pending(job) = &removed {
+                job.cancel.cancel();
+                state.queue.retain(|j| !Arc::ptr_eq(j, job));
+                metrics::counter!("vigil_cancelled_total", "kind" => "precompute", "reason" => "deleted")
+                    .increment(1);
+            }
+        }
+        if let Some(db) = &self.shared.db {
+            db.evictions.fetch_add(1, Ordering::SeqCst);
+            held |= db.cache.get(id).is_some();
+            db.cache.remove(id);
         }
         self.update_gauges(&state);
-        Ok(removed)
+        held
+    }
+
+    /// Checks the registered scenarios held here against the database's
+    /// table and drops those no longer in it; returns how many.
+    ///
+    /// # Errors
+    /// [`DbError`] if the database cannot be read.
+    pub async fn recheck(&self) -> Result<usize, DbError> {
+        let Some(db) = &self.shared.db else {
+            return Ok(0);
+        };
+        let mut held: Vec<String> = self
+            .read()
+            .scenarios
+            .keys()
+            .filter(|id| !Self::is_builtin(id))
+            .cloned()
+            .collect();
+        held.extend(db.cache.ids());
+        if held.is_empty() {
+            return Ok(0);
+        }
+        let present = db.store.existing(&held).await?;
+        let mut dropped = 0;
+        for id in held.iter().filter(|id| !present.contains(*id)) {
+            tracing::info!(%id, "dropping a scenario deleted from the database");
+            self.evict(id);
+            dropped += 1;
+        }
+        Ok(dropped)
+    }
+
+    /// With a database, starts the background tasks on the current tokio
+    /// runtime: one follows deletions (evicting each deleted id at once,
+    /// and after every (re)connection checking what is held against the
+    /// table, see [`Registry::recheck`]); one checks every second that the
+    /// database answers (`/healthz`, `vigil_database_up`). Without one,
+    /// does nothing.
+    pub fn watch(&self) {
+        let Some(db) = &self.shared.db else {
+            return;
+        };
+        let store = db.store.clone();
+        tokio::spawn(async move {
+            loop {
+                store.ping().await;
+                tokio::time::sleep(Duration::from_secs(1)).await;
+            }
+        });
+        let registry = self.clone();
+        tokio::spawn(async move {
+            let Some(store) = registry.database().cloned() else {
+                return;
+            };
+            loop {
+                match store.listen().await {
+                    Ok(mut deletions) => match registry.recheck().await {
+                        Ok(dropped) => {
+                            tracing::info!(dropped, "following deletions in the database");
+                            loop {
+                                let next = tokio::select! {
+                                    next = deletions.next() => next,
+                                    // A connection cut without a reset
+                                    // never ends `next`: the check every
+                                    // second notices it instead.
+                                    () = down(&store) => Err(DbError::Down),
+                                };
+                                match next {
+                                    Ok(id) => {
+                                        if registry.evict(&id) {
+                                            tracing::info!(%id, "dropped a scenario deleted through another replica");
+                                        }
+                                    }
+                                    Err(e) => {
+                                        tracing::warn!(error = %e, "lost the database's deletion notifications; reconnecting");
+                                        break;
+                                    }
+                                }
+                            }
+                        }
+                        Err(e) => tracing::warn!(error = %e, "cannot check the held scenarios"),
+                    },
+                    Err(e) => tracing::debug!(error = %e, "cannot follow deletions yet"),
+                }
+                tokio::time::sleep(Duration::from_millis(250)).await;
+            }
+        });
     }
 
     /// Waits until no job runs or waits, up to `timeout` (for tests and
@@ -573,5 +983,20 @@ impl Registry {
             }
             std::thread::sleep(Duration::from_millis(5));
         }
+    }
+}
+
+/// Resolves once the database's check every second has failed.
+async fn down(store: &PgStore) {
+    while store.is_up() {
+        tokio::time::sleep(Duration::from_millis(200)).await;
+    }
+}
+
+/// The id of an entry's scenario.
+pub fn entry_id(entry: &Entry) -> &str {
+    match entry {
+        Entry::Ready(p) => &p.scenario.id,
+        Entry::Pending(j) => &j.scenario.id,
     }
 }

@@ -17,7 +17,9 @@ use super::extract::{Json, Path};
 use super::middleware::RequestStart;
 use super::openapi::{self as doc, examples};
 use super::plan::CancelOnDrop;
-use super::registry::{Entry, JobStatus, precompute_cancellable, predicted_precompute_ms};
+use super::registry::{
+    Entry, JobStatus, Listed, entry_id, precompute_cancellable, predicted_precompute_ms,
+};
 use crate::cancel::Progress;
 use crate::planner::Planner;
 use crate::scenario::{DEFAULT_TYPE, Scenario, ScenarioSpec};
@@ -50,6 +52,10 @@ pub enum ScenarioStatus {
     Precomputing,
     /// Precomputed: plans and statistics are served.
     Ready,
+    /// Only in a list, with `--database-url`: registered in the shared
+    /// database and not yet used on this replica; its first plan or read
+    /// here precomputes it (or starts its job, if large).
+    Stored,
 }
 
 /// A registered scenario, as `GET /v1/scenarios/{id}` returns it.
@@ -61,7 +67,8 @@ pub struct ScenarioSummary {
     pub spec: ScenarioSpec,
     /// Lattice size.
     pub grid: Grid,
-    /// `ready`, or `queued` / `precomputing` while a job precomputes it.
+    /// `ready`, or `queued` / `precomputing` while a job precomputes it
+    /// (`stored` in a list: not yet used on this replica).
     pub status: ScenarioStatus,
     /// Share of the precomputation done, 0..1 (1 when ready).
     #[schema(minimum = 0.0, maximum = 1.0)]
@@ -114,6 +121,27 @@ impl ScenarioSummary {
                 }),
                 Entry::Pending(_) => None,
             },
+        }
+    }
+}
+
+impl ScenarioSummary {
+    /// The summary of a scenario stored in the database and not yet used
+    /// on this replica.
+    pub fn stored(scenario: &Scenario) -> Self {
+        Self {
+            id: scenario.id.clone(),
+            spec: scenario.spec.clone(),
+            grid: Grid {
+                cols: scenario.cols,
+                rows: scenario.rows,
+            },
+            status: ScenarioStatus::Stored,
+            progress: 0.0,
+            eta_s: None,
+            queue_position: None,
+            predicted_precompute_ms: (predicted_precompute_ms(scenario) * 100.0).round() / 100.0,
+            summary: None,
         }
     }
 }
@@ -185,20 +213,26 @@ pub struct StatsQuery {
     operation_id = "listScenarios",
     tag = "scenarios",
     summary = "List scenarios",
-    description = "Every registered scenario, built-in and client-registered, sorted by id.",
+    description = "Every registered scenario, built-in and client-registered, sorted by id. \
+        With a shared database (`--database-url`) this is the database's catalogue: a scenario \
+        not yet used on this replica is listed with `status` `stored`.",
     responses(
         (status = 200, description = "The registered scenarios.", body = ScenarioList,
             example = json!(examples::scenario_list())),
     )
 )]
-pub async fn list(State(state): State<AppState>) -> Json<ScenarioList> {
+pub async fn list(State(state): State<AppState>) -> Result<Json<ScenarioList>, ApiError> {
     let scenarios = state
         .registry
-        .list()
+        .catalogue()
+        .await?
         .iter()
-        .map(|(entry, job)| ScenarioSummary::of(entry, *job))
+        .map(|listed| match listed {
+            Listed::Held(entry, job) => ScenarioSummary::of(entry, *job),
+            Listed::Stored(scenario) => ScenarioSummary::stored(scenario),
+        })
         .collect();
-    Json(ScenarioList { scenarios })
+    Ok(Json(ScenarioList { scenarios }))
 }
 
 /// `POST /v1/scenarios`, body [`ScenarioSpec`] → 201 with the
@@ -260,36 +294,30 @@ pub async fn create(
     let registry = state.registry.clone();
     if predicted_precompute_ms(&scenario) > registry.limits().sync_precompute_ms {
         // Stored durably before the 202, so a restart resumes it.
-        let (entry, created) =
-            tokio::task::spawn_blocking(move || registry.submit(scenario)).await??;
+        let (entry, created) = registry.submit(scenario).await?;
         let job = state
             .registry
-            .entry(&entry_id(&entry))
+            .entry(entry_id(&entry))
             .and_then(|(_, job)| job);
         return registered(&entry, job, created);
     }
-    // Precompute and store off the async workers; a 2xx means it is on
-    // disk. Cancelled (and not stored) if nobody waits for the answer.
+    // Precompute off the async workers, then store; a 2xx means it is
+    // stored. Cancelled (and not stored) if nobody waits for the answer.
     let guard = CancelOnDrop::new("precompute", start, &state);
     let token = guard.token();
-    let (entry, created) = tokio::task::spawn_blocking(move || {
+    let planner = tokio::task::spawn_blocking(move || {
         let planner = precompute_cancellable(scenario, &token, &Progress::default())
             .map_err(|_| ApiError::Timeout)?;
         token.check().map_err(|_| ApiError::Timeout)?;
-        // A concurrent identical request may have registered it meanwhile;
-        // the first one stays.
-        registry.insert(Arc::new(planner))
+        Ok::<_, ApiError>(planner)
     })
     .await??;
+    // A concurrent identical request (here, or through another replica
+    // sharing the database) may have registered it meanwhile; the first
+    // one stays, and this answer is 200.
+    let (entry, created) = registry.insert(Arc::new(planner)).await?;
     guard.finish();
     registered(&entry, None, created)
-}
-
-fn entry_id(entry: &Entry) -> String {
-    match entry {
-        Entry::Ready(p) => p.scenario.id.clone(),
-        Entry::Pending(j) => j.scenario.id.clone(),
-    }
 }
 
 /// The answer to a registration: 201 with `Location` for a new ready
@@ -330,10 +358,7 @@ pub async fn get(
     State(state): State<AppState>,
     Path(id): Path<String>,
 ) -> Result<Json<ScenarioSummary>, ApiError> {
-    let (entry, job) = state
-        .registry
-        .entry(&id)
-        .ok_or(ApiError::ScenarioNotFound(id))?;
+    let (entry, job) = state.registry.lookup(&id).await?;
     Ok(Json(ScenarioSummary::of(&entry, job)))
 }
 
@@ -358,8 +383,7 @@ pub async fn delete(
     State(state): State<AppState>,
     Path(id): Path<String>,
 ) -> Result<StatusCode, ApiError> {
-    let registry = state.registry.clone();
-    tokio::task::spawn_blocking(move || registry.remove(&id)).await??;
+    state.registry.remove(&id).await?;
     Ok(StatusCode::NO_CONTENT)
 }
 
@@ -390,7 +414,7 @@ pub async fn stats(
     let query = axum::extract::Query::<StatsQuery>::try_from_uri(&uri)
         .map_err(|e| ApiError::BadQuery(e.body_text()))?
         .0;
-    let planner = state.registry.ready(&id)?;
+    let planner = state.registry.resolve(&id).await?;
     let name = query.sensor_type.as_deref().unwrap_or(DEFAULT_TYPE);
     let ty = planner
         .scenario

@@ -1,4 +1,5 @@
-//! Durable scenarios: one JSON file per registered scenario in a directory.
+//! The file store, the default: one JSON file per registered scenario in a
+//! directory of this replica's own.
 //!
 //! A write is atomic and durable before it is acknowledged: the file is
 //! written under a temporary name, fsynced, renamed over its final name, and
