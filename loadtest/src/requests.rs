@@ -47,8 +47,9 @@ pub fn generate(planner: &Planner, workload: &Workload, count: usize) -> Result<
     Ok(workload.requests(planner, count))
 }
 
-/// The session replay of the same run as [`generate`]: the settings, the
-/// warm-up steps and `count` timed steps ([`Workload::session`]).
+/// The requests of [`generate`] and the session replay of the same run:
+/// the settings, the warm-up steps and `count` timed steps, timed step `k`
+/// leading to the state of request `k` ([`Workload::requests_and_session`]).
 ///
 /// # Errors
 /// As [`generate`].
@@ -56,9 +57,9 @@ pub fn generate_session(
     planner: &Planner,
     workload: &Workload,
     count: usize,
-) -> Result<SessionWorkload> {
+) -> Result<(Vec<PlanRequest>, SessionWorkload)> {
     check(workload, count)?;
-    Ok(workload.session(planner, count))
+    Ok(workload.requests_and_session(planner, count))
 }
 
 /// The API's bounds on a generated workload.
