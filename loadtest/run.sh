@@ -12,7 +12,13 @@
 #   3. healthz-sweep.json GET /healthz climbed to its knee: the HTTP stack's ceiling
 #   4. fixed.json         plans at $FIXED_RATE/s for $FIXED_DURATION
 #   5. plan-sweep.json    plans climbed until p99 > $SLO_MS: the knee
-#   6. summary.json       all of it, and the HTTP efficiency
+#   6. session-inproc.json   session steps of the same states in process (core
+#                            $SERVER_CPU, before the server starts), beside
+#                            their stateless plans timed alternately
+#   7. session-fixed.json    session steps ($SESSIONS sessions) at $FIXED_RATE/s
+#   8. session-sweep.json    session steps climbed until p99 > $SLO_MS
+#   9. summary.json       all of it, and the HTTP efficiency
+# SESSIONS=0 leaves the session steps out.
 # Every setting below can be overridden from the environment.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -43,6 +49,7 @@ SWEEP_REFINE=${SWEEP_REFINE:-$def_refine}
 HEALTHZ_START=${HEALTHZ_START:-1000}
 HEALTHZ_FACTOR=${HEALTHZ_FACTOR:-1.5}
 INPROC_ITERATIONS=${INPROC_ITERATIONS:-$def_iters}
+SESSIONS=${SESSIONS:-32}                 # sessions of the HTTP session runs; 0: none
 
 for tool in taskset curl cargo; do
     command -v "$tool" >/dev/null || { echo "run.sh: $tool is required" >&2; exit 1; }
@@ -72,6 +79,13 @@ gen gen --scenario "$SCENARIO" $WORKLOAD --out "$RESULTS/requests.jsonl"
 echo "== in-process plan time (core $SERVER_CPU, server not started yet)"
 taskset -c "$SERVER_CPU" "$lt_bin" inproc --scenario "$SCENARIO" --requests "$RESULTS/requests.jsonl" \
     --iterations "$INPROC_ITERATIONS" --out "$RESULTS/inproc.json"
+
+if (( SESSIONS > 0 )); then
+    echo "== in-process session steps of the same states (core $SERVER_CPU)"
+    # shellcheck disable=SC2086 # WORKLOAD is a list of options
+    taskset -c "$SERVER_CPU" "$lt_bin" inproc --session --scenario "$SCENARIO" $WORKLOAD \
+        --iterations "$INPROC_ITERATIONS" --out "$RESULTS/session-inproc.json"
+fi
 
 echo "== starting vigil-server on core $SERVER_CPU"
 data_dir=$(mktemp -d)
@@ -122,8 +136,28 @@ gen "${common[@]}" "${plans[@]}" --sweep --sweep-start "$SWEEP_START" \
     --sweep-factor "$SWEEP_FACTOR" --sweep-refine "$SWEEP_REFINE" --slo-ms "$SLO_MS" \
     --duration "$STEP_DURATION" --warmup "$STEP_WARMUP" --out "$RESULTS/plan-sweep.json"
 
+session_files=()
+if (( SESSIONS > 0 )); then
+    # shellcheck disable=SC2206 # WORKLOAD is a list of options
+    steps=(--endpoint session --sessions "$SESSIONS" --scenario "$SCENARIO" $WORKLOAD)
+    # The steps are generated: the seed is WORKLOAD's (--seed seeds both the
+    # simulated run and the arrivals), not common's.
+    session_common=(--url "$url" --connections "$CONNECTIONS" --arrivals "$ARRIVALS")
+
+    echo "== session steps at $FIXED_RATE/s for $FIXED_DURATION ($SESSIONS sessions)"
+    gen "${session_common[@]}" "${steps[@]}" --rate "$FIXED_RATE" \
+        --duration "$FIXED_DURATION" --warmup "$FIXED_WARMUP" --out "$RESULTS/session-fixed.json"
+
+    echo "== session sweep (from $SWEEP_START/s x$SWEEP_FACTOR, SLO p99 <= $SLO_MS ms)"
+    gen "${session_common[@]}" "${steps[@]}" --sweep --sweep-start "$SWEEP_START" \
+        --sweep-factor "$SWEEP_FACTOR" --sweep-refine "$SWEEP_REFINE" --slo-ms "$SLO_MS" \
+        --duration "$STEP_DURATION" --warmup "$STEP_WARMUP" --out "$RESULTS/session-sweep.json"
+    session_files=(--session-inproc "$RESULTS/session-inproc.json"
+        --session-fixed "$RESULTS/session-fixed.json" --session-sweep "$RESULTS/session-sweep.json")
+fi
+
 echo "== summary"
 "$lt_bin" summarize --server-cores "$SERVER_CORES" --inproc "$RESULTS/inproc.json" \
     --healthz-sweep "$RESULTS/healthz-sweep.json" --fixed "$RESULTS/fixed.json" \
-    --plan-sweep "$RESULTS/plan-sweep.json" --out "$RESULTS/summary.json"
+    --plan-sweep "$RESULTS/plan-sweep.json" "${session_files[@]}" --out "$RESULTS/summary.json"
 echo "results in $RESULTS/"

@@ -33,6 +33,7 @@ use hdrhistogram::Histogram;
 use reqwest::header::{AUTHORIZATION, CONTENT_TYPE, HeaderValue};
 use serde::{Deserialize, Serialize};
 use tokio::sync::mpsc;
+use vigil::session::{SessionSettings, StepRequest};
 
 use crate::schedule::{Arrivals, Schedule};
 
@@ -51,6 +52,28 @@ pub enum Target {
         /// The full URL.
         url: String,
     },
+    /// The steps of sessions (`POST {base}/v1/sessions/{id}/step`), opened
+    /// and warmed before the run and closed after it.
+    Session(Arc<SessionTarget>),
+}
+
+/// Session mode: request `i` is the next step of session `i mod sessions`,
+/// and a session's steps never overlap.
+#[derive(Debug)]
+pub struct SessionTarget {
+    /// `{base}/v1/sessions`.
+    pub sessions_url: String,
+    /// `{base}/v1/sessions/{id}/step`, for messages.
+    pub step_url: String,
+    /// Body of `POST /v1/sessions`: the scenario and the settings.
+    pub create: Bytes,
+    /// Step bodies replayed untimed into every new session, in order.
+    pub warmup: Vec<Bytes>,
+    /// Step bodies of the run: a session's `j`-th step sends
+    /// `steps[j % len]`.
+    pub steps: Vec<Bytes>,
+    /// Sessions open during the run.
+    pub sessions: usize,
 }
 
 impl Target {
@@ -71,6 +94,47 @@ impl Target {
         })
     }
 
+    /// The steps of `sessions` sessions on `scenario`, created with
+    /// `settings`, each warmed by `warmup` then stepping through `steps`
+    /// (cycled).
+    ///
+    /// # Errors
+    /// If there is no step or no session.
+    pub fn session(
+        base: &str,
+        scenario: &str,
+        settings: &SessionSettings,
+        warmup: &[StepRequest],
+        steps: &[StepRequest],
+        sessions: usize,
+    ) -> Result<Self> {
+        if steps.is_empty() {
+            bail!("no session step to send");
+        }
+        if sessions == 0 {
+            bail!("--sessions must be at least 1");
+        }
+        let mut create = serde_json::to_value(settings)?;
+        if let serde_json::Value::Object(fields) = &mut create {
+            fields.insert("scenario_id".into(), scenario.into());
+        }
+        let bodies = |steps: &[StepRequest]| -> Result<Vec<Bytes>> {
+            steps
+                .iter()
+                .map(|s| Ok(Bytes::from(serde_json::to_vec(s)?)))
+                .collect()
+        };
+        let base = base.trim_end_matches('/');
+        Ok(Target::Session(Arc::new(SessionTarget {
+            sessions_url: format!("{base}/v1/sessions"),
+            step_url: format!("{base}/v1/sessions/{{id}}/step"),
+            create: Bytes::from(serde_json::to_vec(&create)?),
+            warmup: bodies(warmup)?,
+            steps: bodies(steps)?,
+            sessions,
+        })))
+    }
+
     /// `GET {base}/healthz`.
     pub fn healthz(base: &str) -> Self {
         Target::Get {
@@ -82,6 +146,7 @@ impl Target {
     pub fn url(&self) -> &str {
         match self {
             Target::Post { url, .. } | Target::Get { url } => url,
+            Target::Session(t) => &t.step_url,
         }
     }
 }
@@ -151,6 +216,10 @@ pub struct RunReport {
     /// lateness plus the queueing for a free connection. Large values mean
     /// the generator (or its number of connections) is the bottleneck.
     pub send_wait: Histogram<u64>,
+    /// Session mode: wait of every request in the window for its
+    /// session's previous step to finish, µs (counted in its latency too).
+    /// Empty in the other modes.
+    pub session_wait: Histogram<u64>,
     /// 2xx responses recorded.
     pub ok: u64,
     /// Non-2xx statuses other than 503.
@@ -190,6 +259,14 @@ impl RunReport {
             ms(&self.send_wait, 0.99),
             max_ms(&self.send_wait)
         );
+        if !self.session_wait.is_empty() {
+            out += &format!(
+                "\nsession wait ms (for the session's previous step): p50 {:.3}  p99 {:.3}  max {:.3}",
+                ms(&self.session_wait, 0.5),
+                ms(&self.session_wait, 0.99),
+                max_ms(&self.session_wait)
+            );
+        }
         if s.errors > 0 {
             out += &format!(
                 "\nerrors: {} bad status, {} transport, {} timeouts; first: {}",
@@ -262,16 +339,200 @@ fn request(
     let rb = match target {
         Target::Post { url, bodies } => {
             let body = bodies[(seq % bodies.len() as u64) as usize].clone();
-            client
-                .post(url)
-                .header(CONTENT_TYPE, HeaderValue::from_static("application/json"))
-                .body(body)
+            post(client, url, body)
         }
         Target::Get { url } => client.get(url),
+        // Opening a session; the steps are sent by the session workers.
+        Target::Session(t) => post(client, &t.sessions_url, t.create.clone()),
     };
     match auth {
         Some(a) => rb.header(AUTHORIZATION, a.clone()),
         None => rb,
+    }
+}
+
+fn post(client: &reqwest::Client, url: &str, body: Bytes) -> reqwest::RequestBuilder {
+    client
+        .post(url)
+        .header(CONTENT_TYPE, HeaderValue::from_static("application/json"))
+        .body(body)
+}
+
+fn with_auth(rb: reqwest::RequestBuilder, auth: Option<&HeaderValue>) -> reqwest::RequestBuilder {
+    match auth {
+        Some(a) => rb.header(AUTHORIZATION, a.clone()),
+        None => rb,
+    }
+}
+
+/// Sends `rb` and reads its answer: the body of a 2xx, else an error
+/// naming `what`, the status and the start of the body.
+async fn expect_ok(rb: reqwest::RequestBuilder, what: &str) -> Result<Bytes> {
+    let res = rb
+        .send()
+        .await
+        .with_context(|| format!("cannot reach {what}"))?;
+    let status = res.status();
+    if !status.is_success() {
+        let body = res.text().await.unwrap_or_default();
+        let body: String = body.chars().take(500).collect();
+        bail!("{what} answered {status}: {body}");
+    }
+    res.bytes()
+        .await
+        .with_context(|| format!("reading the answer of {what}"))
+}
+
+/// One open session of a session-mode run.
+#[derive(Debug)]
+struct SessionSlot {
+    /// `{base}/v1/sessions/{id}`.
+    url: String,
+    /// `{base}/v1/sessions/{id}/step`.
+    step_url: String,
+    /// Steps finished (answered, failed or given up), in order: step `j`
+    /// is sent once this reaches `j`.
+    done: tokio::sync::watch::Sender<u64>,
+}
+
+/// Opens `t.sessions` sessions and replays the warm-up steps into each,
+/// a few sessions at a time (a 503 is retried after a pause).
+///
+/// # Errors
+/// If a session cannot be created or a warm-up step fails; the sessions
+/// already opened are closed first.
+async fn open_sessions(
+    client: &reqwest::Client,
+    t: &Arc<SessionTarget>,
+    auth: Option<&HeaderValue>,
+    timeout: Duration,
+) -> Result<Vec<SessionSlot>> {
+    let mut slots = Vec::with_capacity(t.sessions);
+    for _ in 0..t.sessions {
+        let created = expect_ok(
+            with_auth(post(client, &t.sessions_url, t.create.clone()), auth).timeout(timeout),
+            &format!("POST {}", t.sessions_url),
+        )
+        .await;
+        let id = created.and_then(|body| {
+            let v: serde_json::Value =
+                serde_json::from_slice(&body).context("the new session is not JSON")?;
+            v.get("id")
+                .and_then(serde_json::Value::as_str)
+                .map(str::to_owned)
+                .context("the new session has no id")
+        });
+        match id {
+            Ok(id) => {
+                let url = format!("{}/{id}", t.sessions_url);
+                slots.push(SessionSlot {
+                    step_url: format!("{url}/step"),
+                    url,
+                    done: tokio::sync::watch::Sender::new(0),
+                });
+            }
+            Err(e) => {
+                close_sessions(client, &slots, auth, timeout).await;
+                return Err(e);
+            }
+        }
+    }
+    // Warm-up: each session's steps in order, a few sessions at once so
+    // that the server does not shed them.
+    const AT_ONCE: usize = 4;
+    let mut set = tokio::task::JoinSet::new();
+    let mut warmed = Ok(());
+    for (i, slot) in slots.iter().enumerate() {
+        if set.len() == AT_ONCE
+            && let Some(r) = set.join_next().await
+        {
+            warmed = warmed.and(r.context("a warm-up task failed")?);
+        }
+        if warmed.is_err() {
+            break;
+        }
+        let (client, t, auth, url) = (
+            client.clone(),
+            Arc::clone(t),
+            auth.cloned(),
+            slot.step_url.clone(),
+        );
+        set.spawn(async move {
+            for (k, body) in t.warmup.iter().enumerate() {
+                let mut tries = 0;
+                loop {
+                    let res = with_auth(post(&client, &url, body.clone()), auth.as_ref())
+                        .timeout(timeout)
+                        .send()
+                        .await;
+                    if let Ok(r) = &res
+                        && r.status() == reqwest::StatusCode::SERVICE_UNAVAILABLE
+                        && tries < 100
+                    {
+                        tries += 1;
+                        tokio::time::sleep(Duration::from_millis(20)).await;
+                        continue;
+                    }
+                    let what = format!("warm-up step {k} of session {i} ({url})");
+                    let res = res.with_context(|| format!("cannot reach {what}"))?;
+                    let status = res.status();
+                    if !status.is_success() {
+                        let body = res.text().await.unwrap_or_default();
+                        let body: String = body.chars().take(500).collect();
+                        bail!("{what} answered {status}: {body}");
+                    }
+                    res.bytes()
+                        .await
+                        .with_context(|| format!("reading {what}"))?;
+                    break;
+                }
+            }
+            Ok(())
+        });
+    }
+    while let Some(r) = set.join_next().await {
+        warmed = warmed.and(r.context("a warm-up task failed")?);
+    }
+    if let Err(e) = warmed {
+        close_sessions(client, &slots, auth, timeout).await;
+        return Err(e);
+    }
+    Ok(slots)
+}
+
+/// Deletes the sessions; a failure is reported on stderr, not an error of
+/// the run (its figures stand).
+async fn close_sessions(
+    client: &reqwest::Client,
+    slots: &[SessionSlot],
+    auth: Option<&HeaderValue>,
+    timeout: Duration,
+) {
+    let mut failed = 0usize;
+    let mut first = None;
+    for slot in slots {
+        let res = with_auth(client.delete(&slot.url), auth)
+            .timeout(timeout)
+            .send()
+            .await;
+        match res {
+            Ok(r) if r.status().is_success() => {}
+            Ok(r) => {
+                failed += 1;
+                first.get_or_insert_with(|| format!("DELETE {}: {}", slot.url, r.status()));
+            }
+            Err(e) => {
+                failed += 1;
+                first.get_or_insert_with(|| format!("DELETE {}: {e}", slot.url));
+            }
+        }
+    }
+    if failed > 0 {
+        eprintln!(
+            "vigil-loadtest: warning: {failed} of {} sessions not closed; first: {}",
+            slots.len(),
+            first.unwrap_or_default()
+        );
     }
 }
 
@@ -284,6 +545,30 @@ fn request(
 pub async fn preflight(target: &Target, api_key: Option<&str>, timeout: Duration) -> Result<()> {
     let client = client(1)?;
     let auth = auth_header(api_key)?;
+    if let Target::Session(t) = target {
+        // One session, its first step, closed again.
+        let one = Arc::new(SessionTarget {
+            sessions_url: t.sessions_url.clone(),
+            step_url: t.step_url.clone(),
+            create: t.create.clone(),
+            warmup: Vec::new(),
+            steps: Vec::new(),
+            sessions: 1,
+        });
+        let slots = open_sessions(&client, &one, auth.as_ref(), timeout).await?;
+        let first = t.warmup.first().or(t.steps.first()).cloned();
+        let stepped = match (&slots[..], first) {
+            ([slot], Some(body)) => expect_ok(
+                with_auth(post(&client, &slot.step_url, body), auth.as_ref()).timeout(timeout),
+                &format!("POST {}", slot.step_url),
+            )
+            .await
+            .map(|_| ()),
+            _ => Ok(()),
+        };
+        close_sessions(&client, &slots, auth.as_ref(), timeout).await;
+        return stepped;
+    }
     let res = request(&client, target, 0, auth.as_ref())
         .timeout(timeout)
         .send()
@@ -314,6 +599,7 @@ struct Job {
 struct Recorder {
     latency: Histogram<u64>,
     send_wait: Histogram<u64>,
+    session_wait: Histogram<u64>,
     ok: u64,
     shed: u64,
     status_errors: u64,
@@ -364,6 +650,7 @@ pub async fn run(cfg: &RunConfig) -> Result<RunReport> {
     let recorder = Arc::new(Mutex::new(Recorder {
         latency: histogram()?,
         send_wait: histogram()?,
+        session_wait: histogram()?,
         ok: 0,
         shed: 0,
         status_errors: 0,
@@ -374,22 +661,30 @@ pub async fn run(cfg: &RunConfig) -> Result<RunReport> {
         first_error: None,
     }));
 
+    let sessions: Option<Arc<[SessionSlot]>> = match &cfg.target {
+        Target::Session(t) => Some(
+            open_sessions(&client, t, auth.as_ref(), cfg.timeout)
+                .await?
+                .into(),
+        ),
+        _ => None,
+    };
+
     let (tx, rx) = mpsc::unbounded_channel::<Job>();
     let rx = Arc::new(tokio::sync::Mutex::new(rx));
     let target = Arc::new(cfg.target.clone());
     let mut workers = Vec::with_capacity(cfg.connections);
     for _ in 0..cfg.connections {
-        let (client, target, rx, recorder, auth) = (
-            client.clone(),
-            Arc::clone(&target),
-            Arc::clone(&rx),
-            Arc::clone(&recorder),
-            auth.clone(),
-        );
-        let timeout = cfg.timeout;
-        workers.push(tokio::spawn(async move {
-            worker(client, target, rx, recorder, auth, timeout).await;
-        }));
+        let w = Worker {
+            client: client.clone(),
+            target: Arc::clone(&target),
+            sessions: sessions.clone(),
+            rx: Arc::clone(&rx),
+            recorder: Arc::clone(&recorder),
+            auth: auth.clone(),
+            timeout: cfg.timeout,
+        };
+        workers.push(tokio::spawn(w.run()));
     }
 
     // A little lead so that the workers are waiting when the first request
@@ -408,6 +703,9 @@ pub async fn run(cfg: &RunConfig) -> Result<RunReport> {
     // sender, so this does not block.
     if dispatcher.join().is_err() {
         bail!("the dispatcher thread panicked");
+    }
+    if let Some(slots) = &sessions {
+        close_sessions(&client, slots, auth.as_ref(), cfg.timeout).await;
     }
 
     let rec = Arc::try_unwrap(recorder)
@@ -439,6 +737,7 @@ pub async fn run(cfg: &RunConfig) -> Result<RunReport> {
         arrivals: cfg.arrivals,
         latency: rec.latency,
         send_wait: rec.send_wait,
+        session_wait: rec.session_wait,
         ok: rec.ok,
         status_errors: rec.status_errors,
         transport_errors: rec.transport_errors,
@@ -471,67 +770,176 @@ fn lock(r: &Mutex<Recorder>) -> std::sync::MutexGuard<'_, Recorder> {
     r.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
-/// One connection: takes the next queued request, sends it, records it.
-async fn worker(
+/// Session mode: request `seq` of a run over `sessions` sessions is step
+/// `seq / sessions` of session `seq % sessions`, and that step sends body
+/// `(seq / sessions) % bodies`: each session walks its own sequence of
+/// bodies in order, cycled when exhausted.
+///
+/// Returns `(session, step, body)`.
+pub fn session_step_of(seq: u64, sessions: usize, bodies: usize) -> (usize, u64, usize) {
+    let k = sessions.max(1) as u64;
+    let step = seq / k;
+    (
+        (seq % k) as usize,
+        step,
+        (step % bodies.max(1) as u64) as usize,
+    )
+}
+
+/// One connection's task.
+struct Worker {
     client: reqwest::Client,
     target: Arc<Target>,
+    /// Session mode: the open sessions.
+    sessions: Option<Arc<[SessionSlot]>>,
     rx: Arc<tokio::sync::Mutex<mpsc::UnboundedReceiver<Job>>>,
     recorder: Arc<Mutex<Recorder>>,
     auth: Option<HeaderValue>,
     timeout: Duration,
-) {
-    loop {
-        let next = { rx.lock().await.recv().await };
-        let Some(job) = next else { return };
-        let taken = Instant::now();
-        let waited = taken.saturating_duration_since(job.intended);
-        if job.measured {
-            lock(&recorder).send_wait.saturating_record(micros(waited));
-        }
-        if waited >= timeout {
-            // Waited its whole budget in the queue: not sent.
+}
+
+impl Worker {
+    /// Takes the next queued request, sends it, records it; until the
+    /// queue closes.
+    ///
+    /// In session mode, request `seq` first waits for the previous step of
+    /// its session ([`session_step_of`]) to finish: a session's steps never
+    /// overlap, and the wait counts in the latency (from the intended
+    /// time), as queueing does. The previous step was taken off the queue
+    /// earlier, by another worker, so the wait always ends, at the latest
+    /// one timeout after that step's intended time.
+    async fn run(self) {
+        let Worker {
+            client,
+            target,
+            sessions,
+            rx,
+            recorder,
+            auth,
+            timeout,
+        } = self;
+        loop {
+            let next = { rx.lock().await.recv().await };
+            let Some(job) = next else { return };
+            let taken = Instant::now();
+            let waited = taken.saturating_duration_since(job.intended);
             if job.measured {
-                let mut r = lock(&recorder);
-                r.timeouts += 1;
-                r.error(|| format!("timed out after {timeout:?} waiting for a connection"));
+                lock(&recorder).send_wait.saturating_record(micros(waited));
             }
-            continue;
+            // Session mode: this step's session, and its place in it.
+            let slot = match (&sessions, &*target) {
+                (Some(slots), Target::Session(t)) => {
+                    let (k, step, body) = session_step_of(job.seq, slots.len(), t.steps.len());
+                    let slot = &slots[k];
+                    let mut done = slot.done.subscribe();
+                    // The sender lives in `slots`: the wait cannot fail.
+                    let _ = done.wait_for(|&d| d >= step).await;
+                    if job.measured {
+                        let w = Instant::now().saturating_duration_since(taken);
+                        lock(&recorder).session_wait.saturating_record(micros(w));
+                    }
+                    Some((slot, step, t.steps[body].clone()))
+                }
+                _ => None,
+            };
+            let waited = Instant::now().saturating_duration_since(job.intended);
+            let outcome = if waited >= timeout {
+                // Waited its whole budget before sending: not sent.
+                None
+            } else {
+                let rb = match &slot {
+                    Some((slot, _, body)) => post(&client, &slot.step_url, body.clone()),
+                    None => request(&client, &target, job.seq, None),
+                };
+                Some(
+                    async {
+                        let res = with_auth(rb, auth.as_ref())
+                            .timeout(timeout - waited)
+                            .send()
+                            .await?;
+                        let status = res.status();
+                        res.bytes().await?;
+                        Ok::<_, reqwest::Error>(status)
+                    }
+                    .await,
+                )
+            };
+            let done = Instant::now();
+            if let Some((slot, step, _)) = &slot {
+                slot.done.send_replace(step + 1);
+            }
+            let mut r = lock(&recorder);
+            let Some(outcome) = outcome else {
+                if job.measured {
+                    r.timeouts += 1;
+                    r.error(|| {
+                        format!(
+                            "timed out after {timeout:?} waiting for a connection or its session"
+                        )
+                    });
+                }
+                continue;
+            };
+            r.sent += 1;
+            if !job.measured {
+                continue;
+            }
+            match outcome {
+                Ok(status) if status.is_success() => {
+                    r.ok += 1;
+                    r.latency
+                        .saturating_record(micros(done.saturating_duration_since(job.intended)));
+                    r.last_ok = Some(r.last_ok.map_or(done, |t| t.max(done)));
+                }
+                Ok(status) if status == reqwest::StatusCode::SERVICE_UNAVAILABLE => r.shed += 1,
+                Ok(status) => {
+                    r.status_errors += 1;
+                    r.error(|| format!("status {status}"));
+                }
+                Err(e) if e.is_timeout() => {
+                    r.timeouts += 1;
+                    r.error(|| format!("timed out after {timeout:?}: {e}"));
+                }
+                Err(e) => {
+                    r.transport_errors += 1;
+                    r.error(|| format!("{e}"));
+                }
+            }
         }
-        let outcome = async {
-            let res = request(&client, &target, job.seq, auth.as_ref())
-                .timeout(timeout - waited)
-                .send()
-                .await?;
-            let status = res.status();
-            res.bytes().await?;
-            Ok::<_, reqwest::Error>(status)
-        }
-        .await;
-        let done = Instant::now();
-        let mut r = lock(&recorder);
-        r.sent += 1;
-        if !job.measured {
-            continue;
-        }
-        match outcome {
-            Ok(status) if status.is_success() => {
-                r.ok += 1;
-                r.latency
-                    .saturating_record(micros(done.saturating_duration_since(job.intended)));
-                r.last_ok = Some(r.last_ok.map_or(done, |t| t.max(done)));
-            }
-            Ok(status) if status == reqwest::StatusCode::SERVICE_UNAVAILABLE => r.shed += 1,
-            Ok(status) => {
-                r.status_errors += 1;
-                r.error(|| format!("status {status}"));
-            }
-            Err(e) if e.is_timeout() => {
-                r.timeouts += 1;
-                r.error(|| format!("timed out after {timeout:?}: {e}"));
-            }
-            Err(e) => {
-                r.transport_errors += 1;
-                r.error(|| format!("{e}"));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn requests_go_round_the_sessions_each_walking_its_bodies_in_order() {
+        // 3 sessions, 2 bodies: 0,1,2 are step 0 of sessions 0,1,2 (body
+        // 0); 3,4,5 their step 1 (body 1); 6 is session 0's step 2, body 0
+        // again.
+        let got: Vec<_> = (0..8).map(|i| session_step_of(i, 3, 2)).collect();
+        assert_eq!(
+            got,
+            [
+                (0, 0, 0),
+                (1, 0, 0),
+                (2, 0, 0),
+                (0, 1, 1),
+                (1, 1, 1),
+                (2, 1, 1),
+                (0, 2, 0),
+                (1, 2, 0)
+            ]
+        );
+        // Every session's steps are consecutive, whatever the counts.
+        for (k, n) in [(1, 1), (4, 7), (32, 200)] {
+            let mut next = vec![0u64; k];
+            for i in 0..1000 {
+                let (s, step, body) = session_step_of(i, k, n);
+                assert_eq!(step, next[s]);
+                assert_eq!(body as u64, step % n as u64);
+                next[s] += 1;
             }
         }
     }

@@ -61,20 +61,29 @@ pub fn measure(planner: &Planner, reqs: &[PlanRequest], iterations: usize) -> Re
         black_box(res.with_context(|| format!("request {} failed", i % reqs.len()))?);
         nanos.push(u64::try_from(dt.as_nanos()).unwrap_or(u64::MAX));
     }
+    Ok(from_nanos(nanos, reqs.len()))
+}
+
+/// The figures of `nanos` (at least one time, ns) over `requests`
+/// distinct requests.
+pub(crate) fn from_nanos(mut nanos: Vec<u64>, requests: usize) -> InprocReport {
     nanos.sort_unstable();
+    let n = nanos.len().max(1);
+    if nanos.is_empty() {
+        nanos.push(0);
+    }
     let at = |q: f64| {
-        let k = ((q * nanos.len() as f64).ceil() as usize).clamp(1, nanos.len()) - 1;
+        let k = ((q * n as f64).ceil() as usize).clamp(1, n) - 1;
         nanos[k] as f64 / 1e6
     };
-    let n = nanos.len();
     let median_ms = if n % 2 == 1 {
         nanos[n / 2] as f64 / 1e6
     } else {
         (nanos[n / 2 - 1] as f64 + nanos[n / 2] as f64) / 2e6
     };
     let mean_ms = nanos.iter().map(|&x| x as f64).sum::<f64>() / n as f64 / 1e6;
-    Ok(InprocReport {
-        requests: reqs.len(),
+    InprocReport {
+        requests,
         iterations: n,
         median_ms,
         p90_ms: at(0.9),
@@ -87,7 +96,7 @@ pub fn measure(planner: &Planner, reqs: &[PlanRequest], iterations: usize) -> Re
         } else {
             f64::INFINITY
         },
-    })
+    }
 }
 
 /// HTTP efficiency: plan throughput per server core divided by what one

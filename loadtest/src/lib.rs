@@ -9,6 +9,8 @@
 //! - [`sweep`]: climbing the rate until p99 passes an SLO (the knee).
 //! - [`inproc`]: the in-process plan time of the same requests, and the
 //!   HTTP efficiency.
+//! - [`session`]: session mode: a session's steps replayed in process
+//!   ([`session::session_step`]), timed beside the stateless plans.
 //! - [`report`]: the summary of a whole `run.sh` session.
 //!
 //! The method and the figures are in the crate's `README.md`.
@@ -18,5 +20,6 @@ pub mod inproc;
 pub mod report;
 pub mod requests;
 pub mod schedule;
+pub mod session;
 pub mod sweep;
 pub mod workload;

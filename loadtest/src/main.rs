@@ -3,8 +3,10 @@
 //!
 //! ```text
 //! vigil-loadtest [OPTIONS]                 one run, or --sweep
+//! vigil-loadtest --endpoint session [...]  the same with the steps of --sessions sessions
 //! vigil-loadtest gen --out FILE [...]      write generated request bodies
 //! vigil-loadtest inproc [...]              in-process plan time of the same requests
+//! vigil-loadtest inproc --session [...]    in-process session step time of the same states
 //! vigil-loadtest summarize [...]           combine run.sh's results, HTTP efficiency
 //! ```
 
@@ -15,15 +17,18 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use serde::Serialize;
-use vigil::planner::PlanRequest;
+use std::sync::Arc;
+
+use vigil::planner::{PlanRequest, Planner};
 
 use vigil_loadtest::generator::{self, RunConfig, Target};
 use vigil_loadtest::inproc;
 use vigil_loadtest::report::Session;
 use vigil_loadtest::requests;
 use vigil_loadtest::schedule::Arrivals;
+use vigil_loadtest::session;
 use vigil_loadtest::sweep::{self, SweepConfig};
-use vigil_loadtest::workload::Workload;
+use vigil_loadtest::workload::{SessionWorkload, Workload};
 
 /// Open-loop load generator for the Vigil planning API.
 ///
@@ -31,7 +36,10 @@ use vigil_loadtest::workload::Workload;
 /// states, or read with --requests) at --rate per second, open loop: the
 /// send times are fixed in advance and latency runs from each request's
 /// intended send time, so queueing in the generator counts. With --sweep,
-/// climbs the rate until p99 passes --slo-ms and reports the knee.
+/// climbs the rate until p99 passes --slo-ms and reports the knee. With
+/// --endpoint session, sends the steps of --sessions sessions of the same
+/// simulator run instead (request i to session i mod N, a session's steps
+/// one at a time).
 #[derive(Debug, Parser)]
 #[command(
     name = "vigil-loadtest",
@@ -65,6 +73,9 @@ enum Endpoint {
     Plan,
     /// GET /healthz: the HTTP stack's ceiling.
     Healthz,
+    /// POST /v1/sessions/{id}/step: the steps of --sessions sessions, each
+    /// opened and warmed before the run (untimed) and closed after it.
+    Session,
 }
 
 /// The requests: generated from vigil-sim states.
@@ -123,6 +134,26 @@ impl WorkloadArgs {
     }
 }
 
+impl WorkloadArgs {
+    /// The session replay of the run (and its stateless requests, the same
+    /// states), generated.
+    fn session(&self, planner: &Planner) -> Result<(Vec<PlanRequest>, SessionWorkload)> {
+        let t = Instant::now();
+        let (reqs, wl) = requests::generate_session(planner, &self.workload(), self.count)?;
+        eprintln!(
+            "generated a session of {} warm-up and {} timed steps ({} sensors, {} steps of history, T = {}, mean {:.1} targets) in {:.1} s",
+            wl.warmup.len(),
+            wl.steps.len(),
+            self.sensors,
+            self.history,
+            self.horizon,
+            mean_targets(&reqs),
+            t.elapsed().as_secs_f64()
+        );
+        Ok((reqs, wl))
+    }
+}
+
 fn mean_targets(reqs: &[PlanRequest]) -> f64 {
     reqs.iter().map(|r| r.targets.len()).sum::<usize>() as f64 / reqs.len().max(1) as f64
 }
@@ -151,6 +182,10 @@ struct RunArgs {
     /// while all are busy, and the wait counts in its latency.
     #[arg(long, default_value_t = 32)]
     connections: usize,
+    /// Sessions of `--endpoint session`: request i is the next step of
+    /// session i mod N, and waits for that session's previous step.
+    #[arg(long, default_value_t = 32)]
+    sessions: usize,
     /// Longest a request may take from its intended send time; past it, it
     /// counts as an error.
     #[arg(long, default_value = "5s", value_parser = parse_duration)]
@@ -210,9 +245,14 @@ struct GenArgs {
 #[derive(Debug, Args)]
 struct InprocArgs {
     /// File of plan request bodies; generated when absent.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "session")]
     requests: Option<PathBuf>,
-    /// Timed plans, cycling through the requests.
+    /// Time session steps instead (prepare + plan + commit, in fresh
+    /// sessions warmed untimed), each beside the stateless plan of the same
+    /// state.
+    #[arg(long)]
+    session: bool,
+    /// Timed plans (or session steps), cycling through the requests.
     #[arg(long, default_value_t = 2000)]
     iterations: usize,
     /// Write the figures as JSON to this file.
@@ -239,6 +279,15 @@ struct SummarizeArgs {
     /// Plan `--sweep --out` file.
     #[arg(long)]
     plan_sweep: Option<PathBuf>,
+    /// `inproc --session --out` file.
+    #[arg(long)]
+    session_inproc: Option<PathBuf>,
+    /// Fixed-rate `--endpoint session` run `--out` file.
+    #[arg(long)]
+    session_fixed: Option<PathBuf>,
+    /// `--endpoint session --sweep --out` file.
+    #[arg(long)]
+    session_sweep: Option<PathBuf>,
     /// Write the combined figures as JSON to this file.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -294,6 +343,9 @@ fn gen_cmd(a: &GenArgs) -> Result<()> {
 }
 
 fn inproc_cmd(a: &InprocArgs) -> Result<()> {
+    if a.session {
+        return inproc_session_cmd(a);
+    }
     let planner = requests::planner_for(&a.workload.scenario)?;
     let reqs = a.workload.requests(a.requests.as_deref())?;
     let r = inproc::measure(&planner, &reqs, a.iterations)?;
@@ -316,6 +368,37 @@ fn inproc_cmd(a: &InprocArgs) -> Result<()> {
     Ok(())
 }
 
+fn inproc_session_cmd(a: &InprocArgs) -> Result<()> {
+    let planner = Arc::new(requests::planner_for(&a.workload.scenario)?);
+    let (reqs, wl) = a.workload.session(&planner)?;
+    let r = session::measure(&planner, &wl, Some(&reqs), a.iterations)?;
+    let s = &r.steps;
+    println!(
+        "in process, {} session steps ({} distinct, {} fresh sessions each warmed by {} untimed steps) on {}: median {:.3} ms  p90 {:.3}  p99 {:.3}  mean {:.3}  max {:.3}  => {:.0} steps/s per core",
+        s.iterations,
+        s.requests,
+        r.sessions,
+        r.warmup_steps,
+        planner.scenario.id,
+        s.median_ms,
+        s.p90_ms,
+        s.p99_ms,
+        s.mean_ms,
+        s.max_ms,
+        r.steps_per_s_per_core
+    );
+    if let Some(p) = &r.stateless {
+        println!(
+            "  the stateless plans of the same states, timed alternately: median {:.3} ms  p90 {:.3}  p99 {:.3}  => {:.0} plans/s per core",
+            p.median_ms, p.p90_ms, p.p99_ms, p.plans_per_s_per_core
+        );
+    }
+    if let Some(out) = &a.out {
+        write_json(out, &r)?;
+    }
+    Ok(())
+}
+
 fn summarize_cmd(a: &SummarizeArgs) -> Result<()> {
     if !(a.server_cores.is_finite() && a.server_cores > 0.0) {
         bail!("--server-cores must be positive");
@@ -326,6 +409,11 @@ fn summarize_cmd(a: &SummarizeArgs) -> Result<()> {
         a.healthz_sweep.as_deref(),
         a.fixed.as_deref(),
         a.plan_sweep.as_deref(),
+    )?
+    .with_sessions(
+        a.session_inproc.as_deref(),
+        a.session_fixed.as_deref(),
+        a.session_sweep.as_deref(),
     )?;
     println!("{}", s.describe());
     if let Some(out) = &a.out {
@@ -350,6 +438,26 @@ fn run_cmd(a: &RunArgs) -> Result<()> {
         Endpoint::Plan => {
             let reqs = a.workload.requests(a.requests.as_deref())?;
             Target::plan(&a.url, &a.workload.scenario, requests::bodies(&reqs)?)?
+        }
+        Endpoint::Session => {
+            if a.requests.is_some() {
+                bail!(
+                    "--endpoint session generates its steps from a vigil-sim run; --requests holds plan bodies"
+                );
+            }
+            if a.sessions == 0 {
+                bail!("--sessions must be at least 1");
+            }
+            let planner = requests::planner_for(&a.workload.scenario)?;
+            let (_, wl) = a.workload.session(&planner)?;
+            Target::session(
+                &a.url,
+                &a.workload.scenario,
+                &wl.settings,
+                &wl.warmup,
+                &wl.steps,
+                a.sessions,
+            )?
         }
     };
     let cfg = RunConfig {
@@ -432,13 +540,21 @@ fn run_cmd(a: &RunArgs) -> Result<()> {
             }
         } else {
             eprintln!(
-                "{} at {}/s ({}) for {:?} after {:?} of warm-up, {} connections",
+                "{} at {}/s ({}) for {:?} after {:?} of warm-up, {} connections{}",
                 cfg.target.url(),
                 cfg.rate,
                 cfg.arrivals,
                 cfg.duration,
                 cfg.warmup,
-                cfg.connections
+                cfg.connections,
+                match &cfg.target {
+                    Target::Session(t) => format!(
+                        ", {} sessions each warmed by {} steps",
+                        t.sessions,
+                        t.warmup.len()
+                    ),
+                    _ => String::new(),
+                }
             );
             let report = generator::run(&cfg).await?;
             println!("{}", report.describe());
@@ -462,6 +578,71 @@ mod tests {
         assert_eq!(parse_duration("2m").unwrap(), Duration::from_secs(120));
         assert!(parse_duration("fast").is_err());
         assert!(parse_duration("-1").is_err());
+    }
+
+    #[test]
+    fn session_mode_parses() {
+        let cli = Cli::try_parse_from([
+            "vigil-loadtest",
+            "--endpoint",
+            "session",
+            "--sessions",
+            "8",
+            "--rate",
+            "2000",
+        ])
+        .expect("valid");
+        assert!(cli.cmd.is_none());
+        assert_eq!(cli.run.endpoint, Endpoint::Session);
+        assert_eq!(cli.run.sessions, 8);
+        let cli = Cli::try_parse_from(["vigil-loadtest"]).expect("valid");
+        assert_eq!(cli.run.endpoint, Endpoint::Plan);
+        assert_eq!(cli.run.sessions, 32);
+        let cli = Cli::try_parse_from([
+            "vigil-loadtest",
+            "inproc",
+            "--session",
+            "--iterations",
+            "10",
+        ])
+        .expect("valid");
+        match cli.cmd {
+            Some(Cmd::Inproc(a)) => {
+                assert!(a.session);
+                assert_eq!(a.iterations, 10);
+            }
+            other => panic!("not inproc: {other:?}"),
+        }
+        // Session steps are generated: no file of plan bodies.
+        assert!(
+            Cli::try_parse_from([
+                "vigil-loadtest",
+                "inproc",
+                "--session",
+                "--requests",
+                "r.json"
+            ])
+            .is_err()
+        );
+        let cli = Cli::try_parse_from([
+            "vigil-loadtest",
+            "summarize",
+            "--session-inproc",
+            "a.json",
+            "--session-fixed",
+            "b.json",
+            "--session-sweep",
+            "c.json",
+        ])
+        .expect("valid");
+        match cli.cmd {
+            Some(Cmd::Summarize(a)) => {
+                assert_eq!(a.session_inproc, Some(PathBuf::from("a.json")));
+                assert_eq!(a.session_fixed, Some(PathBuf::from("b.json")));
+                assert_eq!(a.session_sweep, Some(PathBuf::from("c.json")));
+            }
+            other => panic!("not summarize: {other:?}"),
+        }
     }
 
     #[test]

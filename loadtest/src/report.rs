@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::generator::Summary;
 use crate::inproc::{self, InprocReport};
+use crate::session::SessionInprocReport;
 use crate::sweep::SweepReport;
 
 /// Everything `run.sh` measured, as `summarize --out` writes it.
@@ -41,6 +42,29 @@ pub struct Session {
     /// saturation throughput when a run overloaded the server, whatever its
     /// latency).
     pub http_efficiency_at_max: Option<f64>,
+    /// Sessions: the in-process step times (`inproc --session`), with the
+    /// stateless plans of the same states.
+    #[serde(default)]
+    pub session_inproc: Option<SessionInprocReport>,
+    /// Sessions: the fixed-rate run of steps.
+    #[serde(default)]
+    pub session_fixed: Option<Summary>,
+    /// The SLO of the session sweep, ms.
+    #[serde(default)]
+    pub session_slo_ms: Option<f64>,
+    /// Sessions: the step at the knee.
+    #[serde(default)]
+    pub session_knee: Option<Summary>,
+    /// Sessions: the highest achieved step rate of any run.
+    #[serde(default)]
+    pub session_max_achieved: Option<f64>,
+    /// Achieved step rate at the session knee per server core, divided by
+    /// `1 / in-process step median`.
+    #[serde(default)]
+    pub session_http_efficiency: Option<f64>,
+    /// The same at the highest achieved step rate of any run.
+    #[serde(default)]
+    pub session_http_efficiency_at_max: Option<f64>,
 }
 
 fn read<T: DeserializeOwned>(path: Option<&Path>) -> Result<Option<T>> {
@@ -103,7 +127,51 @@ impl Session {
             plan_max_achieved,
             http_efficiency,
             http_efficiency_at_max,
+            session_inproc: None,
+            session_fixed: None,
+            session_slo_ms: None,
+            session_knee: None,
+            session_max_achieved: None,
+            session_http_efficiency: None,
+            session_http_efficiency_at_max: None,
         })
+    }
+
+    /// Adds the session runs' files given (each optional): the in-process
+    /// steps, the fixed-rate run and the sweep, and derives their
+    /// efficiency as for plans.
+    ///
+    /// # Errors
+    /// If a file given cannot be read or parsed.
+    pub fn with_sessions(
+        mut self,
+        inproc: Option<&Path>,
+        fixed: Option<&Path>,
+        sweep: Option<&Path>,
+    ) -> Result<Self> {
+        let inproc: Option<SessionInprocReport> = read(inproc)?;
+        let fixed: Option<Summary> = read(fixed)?;
+        let sweep: Option<SweepReport> = read(sweep)?;
+        let knee = sweep.as_ref().and_then(|p| p.knee);
+        let max = sweep
+            .as_ref()
+            .and_then(max_achieved)
+            .into_iter()
+            .chain(fixed.map(|f| f.achieved_rate))
+            .reduce(f64::max);
+        let median = inproc.map(|i| i.steps.median_ms);
+        let eff = |rate: Option<f64>| {
+            rate.zip(median)
+                .map(|(r, m)| inproc::http_efficiency(r, self.server_cores, m))
+        };
+        self.session_http_efficiency = eff(knee.map(|k| k.achieved_rate));
+        self.session_http_efficiency_at_max = eff(max);
+        self.session_inproc = inproc;
+        self.session_fixed = fixed;
+        self.session_slo_ms = sweep.as_ref().map(|p| p.slo_ms);
+        self.session_knee = knee;
+        self.session_max_achieved = max;
+        Ok(self)
     }
 
     /// A human-readable summary, several lines.
@@ -165,6 +233,58 @@ impl Session {
             "\n  at the highest plan rate achieved in any run (saturation, any latency): {}",
             f(self.http_efficiency_at_max, 3)
         );
+        if let Some(i) = &self.session_inproc {
+            out += &format!(
+                "\nsessions in process: median {:.3} ms, p90 {:.3}, p99 {:.3} ({:.0} steps/s per core)",
+                i.steps.median_ms, i.steps.p90_ms, i.steps.p99_ms, i.steps_per_s_per_core
+            );
+            if let Some(p) = &i.stateless {
+                out += &format!(
+                    "; the stateless plans of the same states, timed alternately: median {:.3} ms",
+                    p.median_ms
+                );
+            }
+        }
+        if let Some(x) = &self.session_fixed {
+            out += &format!(
+                "\nsession steps at {:.0}/s: achieved {:.1}/s, p50 {:.3} ms, p90 {:.3}, p99 {:.3}, p99.9 {:.3}, max {:.3}, errors {}, shed {}",
+                x.target_rate,
+                x.achieved_rate,
+                x.p50_ms,
+                x.p90_ms,
+                x.p99_ms,
+                x.p999_ms,
+                x.max_ms,
+                x.errors,
+                x.shed
+            );
+        }
+        if self.session_slo_ms.is_some() || self.session_max_achieved.is_some() {
+            match &self.session_knee {
+                Some(k) => {
+                    out += &format!(
+                        "\nsession knee (p99 ≤ {} ms): {:.0}/s target, {:.1}/s achieved, p50 {:.3} ms, p99 {:.3}; highest achieved {}/s",
+                        f(self.session_slo_ms, 1),
+                        k.target_rate,
+                        k.achieved_rate,
+                        k.p50_ms,
+                        k.p99_ms,
+                        f(self.session_max_achieved, 0)
+                    )
+                }
+                None => {
+                    out += &format!(
+                        "\nsession knee: none (the first step failed the SLO or no sweep); highest achieved {}/s",
+                        f(self.session_max_achieved, 0)
+                    )
+                }
+            }
+            out += &format!(
+                "\nsession HTTP efficiency at the knee: {}; at the highest step rate achieved: {}",
+                f(self.session_http_efficiency, 3),
+                f(self.session_http_efficiency_at_max, 3)
+            );
+        }
         out
     }
 }
@@ -231,6 +351,30 @@ mod tests {
         assert!((s.http_efficiency_at_max.unwrap() - 0.45).abs() < 1e-9);
         assert!((s.http_efficiency.unwrap() - 0.3975).abs() < 1e-9);
         assert_eq!(s.healthz_knee_rate, None);
+        // Sessions: the same derivation from their own files.
+        let si = crate::session::SessionInprocReport {
+            steps: InprocReport {
+                median_ms: 0.25,
+                ..inproc
+            },
+            steps_per_s_per_core: 4000.0,
+            warmup_steps: 43,
+            sessions: 1,
+            stateless: Some(inproc),
+        };
+        let si = write("si.json", &si);
+        let sf = write("sf.json", &summary(2000.0, 1900.0, 4.0));
+        let s = Session::from_files(1.0, Some(&i), None, None, Some(&p))
+            .unwrap()
+            .with_sessions(Some(&si), Some(&sf), Some(&p))
+            .unwrap();
+        // 1590/s × 0.25 ms; the fixed run's 1900/s is the highest achieved.
+        assert!((s.session_http_efficiency.unwrap() - 0.3975).abs() < 1e-9);
+        assert_eq!(s.session_max_achieved, Some(1900.0));
+        assert!((s.session_http_efficiency_at_max.unwrap() - 0.475).abs() < 1e-9);
+        assert_eq!(s.session_slo_ms, Some(2.0));
+        assert!(s.describe().contains("session knee"), "{}", s.describe());
+        assert!(s.describe().contains("0.475"), "{}", s.describe());
         let missing = dir.path().join("none.json");
         assert!(Session::from_files(1.0, Some(&missing), None, None, None).is_err());
     }

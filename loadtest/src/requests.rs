@@ -15,7 +15,7 @@ use bytes::Bytes;
 use vigil::planner::{MAX_HISTORY_STEPS, MAX_SENSORS, PlanRequest, Planner};
 use vigil::scenario::builtins;
 
-use crate::workload::Workload;
+use crate::workload::{SessionWorkload, Workload};
 
 /// Largest horizon the API accepts.
 const MAX_HORIZON: usize = 12;
@@ -43,6 +43,27 @@ pub fn planner_for(id: &str) -> Result<Planner> {
 /// If the workload is outside the API's bounds (sensors 1..=256, history
 /// ≤ 32, horizon 1..=12) or `count` is 0.
 pub fn generate(planner: &Planner, workload: &Workload, count: usize) -> Result<Vec<PlanRequest>> {
+    check(workload, count)?;
+    Ok(workload.requests(planner, count))
+}
+
+/// The requests of [`generate`] and the session replay of the same run:
+/// the settings, the warm-up steps and `count` timed steps, timed step `k`
+/// leading to the state of request `k` ([`Workload::requests_and_session`]).
+///
+/// # Errors
+/// As [`generate`].
+pub fn generate_session(
+    planner: &Planner,
+    workload: &Workload,
+    count: usize,
+) -> Result<(Vec<PlanRequest>, SessionWorkload)> {
+    check(workload, count)?;
+    Ok(workload.requests_and_session(planner, count))
+}
+
+/// The API's bounds on a generated workload.
+fn check(workload: &Workload, count: usize) -> Result<()> {
     if workload.sensors == 0 || workload.sensors > MAX_SENSORS {
         bail!(
             "--sensors must be in 1..={MAX_SENSORS}, not {}",
@@ -64,7 +85,7 @@ pub fn generate(planner: &Planner, workload: &Workload, count: usize) -> Result<
     if count == 0 {
         bail!("--count must be at least 1");
     }
-    Ok(workload.requests(planner, count))
+    Ok(())
 }
 
 /// Reads a file of plan request bodies: a JSON array, or JSON lines.

@@ -11,6 +11,7 @@ use vigil::planner::{PlanRequest, Planner, TargetIn};
 use vigil::scenario::{
     SITE_CYCLIST, SITE_VEHICLE, SITE_WALKER, Scenario, SourceSpec, SpeedSpec, site_gates_spec,
 };
+use vigil::session::{SessionSettings, StepRequest};
 use vigil_sim::driver::{Sim, Start, default_warmup};
 use vigil_sim::policy::Policy;
 
@@ -60,10 +61,62 @@ impl Workload {
         count: usize,
         types: Vec<usize>,
     ) -> Vec<PlanRequest> {
+        self.replay(planner, count, types, false).0
+    }
+
+    /// The session steps of the same run as [`Workload::requests`]: every
+    /// step from the run's start, so that a session replaying them holds
+    /// at timed step `k` exactly the state of stateless request `k` (its
+    /// history full, its tracks those of the request), and the settings of
+    /// that session (exact + priority, T, `history` steps kept).
+    ///
+    /// # Panics
+    /// As [`Workload::requests`].
+    pub fn session(&self, planner: &Planner, count: usize) -> SessionWorkload {
+        self.replay(planner, count, vec![0; self.sensors], true).1
+    }
+
+    /// Both at once, from one run: the stateless requests and the session
+    /// steps of the same states (`requests[k]` is the state of
+    /// `session.steps[k]`).
+    ///
+    /// # Panics
+    /// As [`Workload::requests`].
+    pub fn requests_and_session(
+        &self,
+        planner: &Planner,
+        count: usize,
+    ) -> (Vec<PlanRequest>, SessionWorkload) {
+        self.replay(planner, count, vec![0; self.sensors], true)
+    }
+
+    /// The run behind [`Workload::requests_of_fleet`] and
+    /// [`Workload::session`]: the warm-up (sensors staying put while the
+    /// zone fills), then `count` steps moving along the planner's answer.
+    /// With `steps`, every step's session body is recorded too (building
+    /// it draws nothing, so the stateless requests are the same either
+    /// way).
+    fn replay(
+        &self,
+        planner: &Planner,
+        count: usize,
+        types: Vec<usize>,
+        steps: bool,
+    ) -> (Vec<PlanRequest>, SessionWorkload) {
         let s: &Scenario = &planner.scenario;
         let mut sim = Sim::with_types(s.clone(), types, Start::Grid, self.seed, self.history);
+        let mut session = SessionWorkload {
+            settings: sim.session_settings(Policy::Exact, Some(self.horizon), self.history),
+            warmup: Vec::new(),
+            steps: Vec::new(),
+        };
         for _ in 0..default_warmup(s).max(self.history) {
             sim.observe();
+            if steps {
+                session
+                    .warmup
+                    .push(sim.step_request(Policy::Exact, Some(self.horizon)));
+            }
             let stay = sim.sensors.clone();
             sim.advance(stay);
         }
@@ -71,6 +124,11 @@ impl Workload {
         while out.len() < count {
             sim.observe();
             let req = sim.plan_request(Policy::Exact, Some(self.horizon));
+            if steps {
+                session
+                    .steps
+                    .push(sim.step_request(Policy::Exact, Some(self.horizon)));
+            }
             let resp = planner
                 .plan_request(&req)
                 .expect("the simulator's requests are valid");
@@ -80,8 +138,23 @@ impl Workload {
             sim.advance(next);
             out.push(req);
         }
-        out
+        (out, session)
     }
+}
+
+/// A session's replay of a simulator run: what `POST /v1/sessions` and its
+/// steps send.
+#[derive(Debug, Clone)]
+pub struct SessionWorkload {
+    /// The session's settings (exact + priority, T, the history kept).
+    pub settings: SessionSettings,
+    /// The steps of the run's warm-up, before the first timed step: replayed
+    /// untimed into a fresh session so that its history and tracks are
+    /// full when timing starts.
+    pub warmup: Vec<StepRequest>,
+    /// The timed steps: step `k` leads to the state of the stateless
+    /// request `k` of the same run.
+    pub steps: Vec<StepRequest>,
 }
 
 /// `req` with exactly `n` targets: its own first ones, then more on a
