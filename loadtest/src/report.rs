@@ -176,9 +176,6 @@ impl Session {
 
     /// A human-readable summary, several lines.
     pub fn describe(&self) -> String {
-        let f = |x: Option<f64>, digits: usize| {
-            x.map_or_else(|| "-".to_owned(), |v| format!("{v:.digits$}"))
-        };
         let mut out = String::new();
         out += &format!("server cores: {}\n", self.server_cores);
         if let Some(i) = &self.inproc {
@@ -189,49 +186,28 @@ impl Session {
         }
         out += &format!(
             "/healthz: knee {}/s, highest achieved {}/s\n",
-            f(self.healthz_knee_rate, 0),
-            f(self.healthz_max_achieved, 0)
+            opt(self.healthz_knee_rate, 0),
+            opt(self.healthz_max_achieved, 0)
         );
         if let Some(x) = &self.fixed {
-            out += &format!(
-                "plans at {:.0}/s: achieved {:.1}/s, p50 {:.3} ms, p90 {:.3}, p99 {:.3}, p99.9 {:.3}, max {:.3}, errors {}, shed {}\n",
-                x.target_rate,
-                x.achieved_rate,
-                x.p50_ms,
-                x.p90_ms,
-                x.p99_ms,
-                x.p999_ms,
-                x.max_ms,
-                x.errors,
-                x.shed
-            );
+            out += &fixed_line("plans", x);
+            out += "\n";
         }
-        match &self.plan_knee {
-            Some(k) => {
-                out += &format!(
-                    "plan knee (p99 ≤ {} ms): {:.0}/s target, {:.1}/s achieved, p50 {:.3} ms, p99 {:.3}; highest achieved {}/s\n",
-                    f(self.slo_ms, 1),
-                    k.target_rate,
-                    k.achieved_rate,
-                    k.p50_ms,
-                    k.p99_ms,
-                    f(self.plan_max_achieved, 0)
-                )
-            }
-            None => {
-                out += &format!(
-                    "plan knee: none (the first step failed the SLO); highest achieved {}/s\n",
-                    f(self.plan_max_achieved, 0)
-                )
-            }
-        }
+        out += &knee_line(
+            "plan",
+            self.slo_ms,
+            self.plan_knee.as_ref(),
+            self.plan_max_achieved,
+            "the first step failed the SLO",
+        );
+        out += "\n";
         out += &format!(
             "HTTP efficiency = (knee throughput / server cores) / (1 / in-process median) = {}",
-            f(self.http_efficiency, 3)
+            opt(self.http_efficiency, 3)
         );
         out += &format!(
             "\n  at the highest plan rate achieved in any run (saturation, any latency): {}",
-            f(self.http_efficiency_at_max, 3)
+            opt(self.http_efficiency_at_max, 3)
         );
         if let Some(i) = &self.session_inproc {
             out += &format!(
@@ -246,46 +222,71 @@ impl Session {
             }
         }
         if let Some(x) = &self.session_fixed {
-            out += &format!(
-                "\nsession steps at {:.0}/s: achieved {:.1}/s, p50 {:.3} ms, p90 {:.3}, p99 {:.3}, p99.9 {:.3}, max {:.3}, errors {}, shed {}",
-                x.target_rate,
-                x.achieved_rate,
-                x.p50_ms,
-                x.p90_ms,
-                x.p99_ms,
-                x.p999_ms,
-                x.max_ms,
-                x.errors,
-                x.shed
-            );
+            out += "\n";
+            out += &fixed_line("session steps", x);
         }
         if self.session_slo_ms.is_some() || self.session_max_achieved.is_some() {
-            match &self.session_knee {
-                Some(k) => {
-                    out += &format!(
-                        "\nsession knee (p99 ≤ {} ms): {:.0}/s target, {:.1}/s achieved, p50 {:.3} ms, p99 {:.3}; highest achieved {}/s",
-                        f(self.session_slo_ms, 1),
-                        k.target_rate,
-                        k.achieved_rate,
-                        k.p50_ms,
-                        k.p99_ms,
-                        f(self.session_max_achieved, 0)
-                    )
-                }
-                None => {
-                    out += &format!(
-                        "\nsession knee: none (the first step failed the SLO or no sweep); highest achieved {}/s",
-                        f(self.session_max_achieved, 0)
-                    )
-                }
-            }
+            out += "\n";
+            out += &knee_line(
+                "session",
+                self.session_slo_ms,
+                self.session_knee.as_ref(),
+                self.session_max_achieved,
+                "the first step failed the SLO or no sweep",
+            );
             out += &format!(
                 "\nsession HTTP efficiency at the knee: {}; at the highest step rate achieved: {}",
-                f(self.session_http_efficiency, 3),
-                f(self.session_http_efficiency_at_max, 3)
+                opt(self.session_http_efficiency, 3),
+                opt(self.session_http_efficiency_at_max, 3)
             );
         }
         out
+    }
+}
+
+/// `x` or `-`, with `digits` decimals.
+fn opt(x: Option<f64>, digits: usize) -> String {
+    x.map_or_else(|| "-".to_owned(), |v| format!("{v:.digits$}"))
+}
+
+/// One line on a fixed-rate run of `what` (no newline).
+fn fixed_line(what: &str, x: &Summary) -> String {
+    format!(
+        "{what} at {:.0}/s: achieved {:.1}/s, p50 {:.3} ms, p90 {:.3}, p99 {:.3}, p99.9 {:.3}, max {:.3}, errors {}, shed {}",
+        x.target_rate,
+        x.achieved_rate,
+        x.p50_ms,
+        x.p90_ms,
+        x.p99_ms,
+        x.p999_ms,
+        x.max_ms,
+        x.errors,
+        x.shed
+    )
+}
+
+/// One line on a sweep's knee (no newline); `none` says why there is none.
+fn knee_line(
+    what: &str,
+    slo_ms: Option<f64>,
+    knee: Option<&Summary>,
+    max_achieved: Option<f64>,
+    none: &str,
+) -> String {
+    match knee {
+        Some(k) => format!(
+            "{what} knee (p99 ≤ {} ms): {:.0}/s target, {:.1}/s achieved, p50 {:.3} ms, p99 {:.3}; highest achieved {}/s",
+            opt(slo_ms, 1),
+            k.target_rate,
+            k.achieved_rate,
+            k.p50_ms,
+            k.p99_ms,
+            opt(max_achieved, 0)
+        ),
+        None => format!(
+            "{what} knee: none ({none}); highest achieved {}/s",
+            opt(max_achieved, 0)
+        ),
     }
 }
 
