@@ -372,6 +372,12 @@ async fn expect_ok(rb: reqwest::RequestBuilder, what: &str) -> Result<Bytes> {
         .send()
         .await
         .with_context(|| format!("cannot reach {what}"))?;
+    read_ok(res, what).await
+}
+
+/// The body of a 2xx answer, else an error naming `what`, the status and
+/// the start of the body.
+async fn read_ok(res: reqwest::Response, what: &str) -> Result<Bytes> {
     let status = res.status();
     if !status.is_success() {
         let body = res.text().await.unwrap_or_default();
@@ -475,15 +481,7 @@ async fn open_sessions(
                     }
                     let what = format!("warm-up step {k} of session {i} ({url})");
                     let res = res.with_context(|| format!("cannot reach {what}"))?;
-                    let status = res.status();
-                    if !status.is_success() {
-                        let body = res.text().await.unwrap_or_default();
-                        let body: String = body.chars().take(500).collect();
-                        bail!("{what} answered {status}: {body}");
-                    }
-                    res.bytes()
-                        .await
-                        .with_context(|| format!("reading {what}"))?;
+                    read_ok(res, &what).await?;
                     break;
                 }
             }
