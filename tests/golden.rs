@@ -4,7 +4,8 @@
 //! recorded requests of a `vigil-sim` run with 16 steps of history, for
 //! every estimator and coordination, are bit for bit the ones recorded in
 //! `tests/golden/paper-builtins.json` before the change (SHA-256 of their
-//! JSON, compute time zeroed), and the ids of stored specs are unchanged.
+//! JSON, compute time zeroed), on one, two and three threads alike, and
+//! the ids of stored specs are unchanged.
 //! Fields added since (the minimum separation, 0 for the built-ins, and
 //! its violation counts) must be 0, and are left out of the digest.
 #![allow(clippy::unwrap_used, missing_docs)]
@@ -31,8 +32,20 @@ fn strip_separation(resp: &mut Value) {
     }
 }
 
+/// On one, two and three threads: the plans do not depend on how many
+/// cores the replica has.
 #[test]
 fn paper_builtins_answer_exactly_as_before() {
+    for threads in [1, 2, 3] {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| check_builtins(threads));
+    }
+}
+
+fn check_builtins(threads: usize) {
     let doc: Value = serde_json::from_str(include_str!("golden/paper-builtins.json")).unwrap();
     let builtins = builtins();
     let mut checked = 0;
@@ -79,7 +92,7 @@ fn paper_builtins_answer_exactly_as_before() {
             assert_eq!(
                 digest(&resp),
                 case["response_sha256"],
-                "{id}: case {i} ({}) answers differently",
+                "{id}: case {i} ({}) answers differently on {threads} threads",
                 case["override"]
             );
             checked += 1;
