@@ -148,6 +148,13 @@ impl<'a> ExactEstimator<'a> {
     /// first use).
     pub fn prepare(&self) {
         let Some(grid) = self.grid else { return };
+        if let Some(windows) = self.whole_windows(grid) {
+            for (step, win) in self.windows.iter().zip(windows) {
+                // Set once here; nothing else can have built it yet.
+                let _ = step.built[0].set(win);
+            }
+            return;
+        }
         let jobs: Vec<(usize, usize)> = self
             .windows
             .iter()

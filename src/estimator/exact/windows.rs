@@ -175,6 +175,65 @@ impl ExactEstimator<'_> {
         }
     }
 
+    /// Every step's window at once, when each is one window over the whole
+    /// grid (a small grid): the rays' seen intervals are read once for all
+    /// the steps, and the crossing where a ray's first interval starts is
+    /// found from the previous step's (a lift later) instead of by a new
+    /// bisection. Each window gets the same sums in the same order as
+    /// [`ExactEstimator::window`] would give it: the same values to the
+    /// last bit. `None` when the steps' windows are not all the whole grid
+    /// or a ray index is missing.
+    pub(super) fn whole_windows(&self, grid: &ElementaryGrid) -> Option<Vec<Window>> {
+        let (nx, ny) = grid.dims();
+        let whole = (0, nx, 0, ny);
+        if self.windows.is_empty()
+            || !self.windows.iter().all(|w| w.blocks == [whole])
+            || self
+                .classes
+                .iter()
+                .any(|c| self.rays[c.rays].crossings.is_none())
+        {
+            return None;
+        }
+        let steps = self.windows.len();
+        let per_group: Vec<Vec<Vec<f64>>> = self
+            .classes
+            .par_chunks(CLASSES_PER_BUFFER)
+            .zip(self.seen.par_chunks(CLASSES_PER_BUFFER))
+            .map(|(classes, seen)| {
+                let mut accs = vec![vec![0.0; nx * ny]; steps];
+                for (class, seen) in classes.iter().zip(seen) {
+                    accumulate_whole(&self.rays[class.rays], class, seen, &mut accs);
+                }
+                accs
+            })
+            .collect();
+        let mut mass = Vec::with_capacity(nx * ny);
+        for b in 0..ny {
+            for a in 0..nx {
+                mass.push(grid.mass(a, a + 1, b, b + 1));
+            }
+        }
+        let windows = (0..steps)
+            .map(|t| {
+                let mut unseen = mass.clone();
+                for accs in &per_group {
+                    for (u, s) in unseen.iter_mut().zip(&accs[t]) {
+                        *u -= s;
+                    }
+                }
+                Window {
+                    a0: 0,
+                    b0: 0,
+                    na: nx,
+                    nb: ny,
+                    unseen,
+                }
+            })
+            .collect();
+        Some(windows)
+    }
+
     /// Adds to `acc` what the rays of one source saw in each rectangle of
     /// `block` at lift `v·t`, times the class's weight `w`.
     #[allow(clippy::too_many_arguments)]
@@ -338,6 +397,71 @@ impl ExactEstimator<'_> {
         }
         BlockSums { a0, b0, w, prefix }
     }
+}
+
+/// What the rays of one class saw in each rectangle of the whole grid, at
+/// every step `t` (lift `v·t`) into `accs[t − 1]`, times the class's
+/// weight: the whole-grid branch of [`ExactEstimator::accumulate`] for all
+/// the steps in one pass over the rays.
+fn accumulate_whole(
+    sr: &SourceRays,
+    class: &super::ClassRays,
+    seen: &RayHits,
+    accs: &mut [Vec<f64>],
+) {
+    let Some(cr) = &sr.crossings else { return };
+    for m in 0..sr.dirs.len() {
+        let (rs, _, lin) = cr.of(m);
+        let hits = seen.of(m);
+        if hits.is_empty() || lin.is_empty() {
+            continue;
+        }
+        let detected = seen.detected(m);
+        // Where the previous step's first interval started.
+        let mut hint = usize::MAX;
+        for (t, acc) in accs.iter_mut().enumerate() {
+            let lift = class.speed * (t + 1) as f64;
+            let end = rs[lin.len()] - lift;
+            let from = hits.partition_point(|&(_, q)| q + lift <= rs[0]);
+            let mut k = usize::MAX;
+            for (i, &(p, q)) in hits.iter().enumerate().skip(from) {
+                if p >= end {
+                    break;
+                }
+                let w = if detected.is_empty() {
+                    class.weight
+                } else {
+                    class.weight * detected[i]
+                };
+                let (p, q) = (p + lift, q + lift);
+                k = if k == usize::MAX {
+                    hint = first_crossing(rs, hint, p);
+                    hint
+                } else {
+                    next_crossing(rs, k, p)
+                };
+                while k < lin.len() && rs[k] < q {
+                    acc[lin[k] as usize] += w * (min(rs[k + 1], q) - max(rs[k], p));
+                    k += 1;
+                }
+            }
+        }
+    }
+}
+
+/// The crossing whose segment holds `p` (as a bisection would find it:
+/// the last `k` with `rs[k] ≤ p`, or 0), scanning on from `hint` when
+/// `rs[hint] ≤ p`, else by bisection.
+#[inline]
+fn first_crossing(rs: &[f64], hint: usize, p: f64) -> usize {
+    if hint < rs.len() && rs[hint] <= p {
+        let mut k = hint;
+        while k + 1 < rs.len() && rs[k + 1] <= p {
+            k += 1;
+        }
+        return k;
+    }
+    rs.partition_point(|&x| x <= p).saturating_sub(1)
 }
 
 /// The crossing whose segment holds `p`, for the intervals of one ray in
