@@ -423,8 +423,21 @@ impl Estimator for ExactEstimator<'_> {
         let all: Vec<&Look> = excluded.iter().collect();
         let mut clear: Vec<Point> = Vec::with_capacity(self.known.len());
         let mut partial: Vec<(Point, f64)> = Vec::new();
+        // Only targets some field of view of the reach can hold: every one
+        // lies within the start's, moved by at most `ti` cells (a cell more
+        // for rounding). Most of a zone's targets are far from one sensor.
+        let reach = {
+            let r = s.fov_region_of(self.types[sensor], start).rect;
+            let m = s.cell_size * f64::from(ti + 1);
+            crate::geometry::Rect {
+                x0: r.x0 - m,
+                y0: r.y0 - m,
+                x1: r.x1 + m,
+                y1: r.y1 + m,
+            }
+        };
         for p in self.known.iter().map(|tg| tg.at(t)) {
-            if !s.in_zone(p) {
+            if !s.in_zone(p) || !reach.contains(p) {
                 continue;
             }
             match miss_all(&all, p) {
