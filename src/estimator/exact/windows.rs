@@ -420,6 +420,9 @@ fn accumulate_whole(
         // Where the previous step's first interval started.
         let mut hint = usize::MAX;
         for (t, acc) in accs.iter_mut().enumerate() {
+            // A slice, so its start and length stay in registers across
+            // the stores below.
+            let acc = acc.as_mut_slice();
             let lift = class.speed * (t + 1) as f64;
             let end = rs[lin.len()] - lift;
             let from = hits.partition_point(|&(_, q)| q + lift <= rs[0]);
