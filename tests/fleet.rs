@@ -435,17 +435,25 @@ fn fast_and_general_paths_agree_with_mixed_types() {
             })
             .collect();
         let horizon = 2;
-        let est = ExactEstimator::new(
-            &s,
-            &stats,
-            &rays,
-            Some(&grid),
-            &history,
-            &targets,
-            &starts,
-            &types,
-            horizon,
-        );
+        let new_estimator = || {
+            ExactEstimator::new(
+                &s,
+                &stats,
+                &rays,
+                Some(&grid),
+                &history,
+                &targets,
+                &starts,
+                &types,
+                horizon,
+            )
+        };
+        // One with every window built up front (all steps in one pass when
+        // the windows are the whole grid), one with each built on first
+        // use: the same values to the last bit.
+        let est = new_estimator();
+        est.prepare();
+        let lazy = new_estimator();
         for (i, &start) in starts.iter().enumerate() {
             let other = (i + 1) % starts.len();
             let excluded = [s.look(types[other], starts[other])];
@@ -458,6 +466,11 @@ fn fast_and_general_paths_agree_with_mixed_types() {
                             continue;
                         }
                         let fast = est.value(i, k, t, &[]);
+                        assert_eq!(
+                            fast.to_bits(),
+                            lazy.value(i, k, t, &[]).to_bits(),
+                            "round {round} sensor {i} {k:?} t={t}: prepared and lazy windows"
+                        );
                         let general = est.value_by_rays(i, k, t, &[]);
                         assert!(
                             (fast - general).abs() < 1e-9 * general.abs().max(1.0),

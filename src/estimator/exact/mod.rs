@@ -150,7 +150,8 @@ impl<'a> ExactEstimator<'a> {
         let Some(grid) = self.grid else { return };
         if let Some(windows) = self.whole_windows(grid) {
             for (step, win) in self.windows.iter().zip(windows) {
-                // Set once here; nothing else can have built it yet.
+                // A window already built on first use keeps its (equal)
+                // values.
                 let _ = step.built[0].set(win);
             }
             return;
