@@ -6,7 +6,7 @@ use std::sync::OnceLock;
 
 use rayon::prelude::*;
 
-use super::rays::SourceRays;
+use super::rays::{Crossings, SourceRays};
 use super::seen::RayHits;
 use super::{ExactEstimator, max, min};
 use crate::estimator::elementary::{Block, ElementaryGrid, trace};
@@ -203,7 +203,12 @@ impl ExactEstimator<'_> {
             .map(|(classes, seen)| {
                 let mut accs = vec![vec![0.0; nx * ny]; steps];
                 for (class, seen) in classes.iter().zip(seen) {
-                    accumulate_whole(&self.rays[class.rays], class, seen, &mut accs);
+                    let sr = &self.rays[class.rays];
+                    let Some(cr) = &sr.crossings else { continue };
+                    let lifts: Vec<f64> = (1..=steps).map(|t| class.speed * t as f64).collect();
+                    let mut views: Vec<&mut [f64]> =
+                        accs.iter_mut().map(Vec::as_mut_slice).collect();
+                    accumulate_whole(cr, sr.dirs.len(), class.weight, seen, &lifts, &mut views);
                 }
                 accs
             })
@@ -250,33 +255,7 @@ impl ExactEstimator<'_> {
     ) {
         if let (true, Some(cr)) = (whole, &sr.crossings) {
             // The block is the grid: every ray, no bounds to check.
-            for m in 0..sr.dirs.len() {
-                let (rs, _, lin) = cr.of(m);
-                let hits = seen.of(m);
-                if hits.is_empty() || lin.is_empty() {
-                    continue;
-                }
-                let detected = seen.detected(m);
-                let end = rs[lin.len()] - lift;
-                let from = hits.partition_point(|&(_, q)| q + lift <= rs[0]);
-                let mut k = usize::MAX;
-                for (i, &(p, q)) in hits.iter().enumerate().skip(from) {
-                    if p >= end {
-                        break;
-                    }
-                    let w = if detected.is_empty() {
-                        w
-                    } else {
-                        w * detected[i]
-                    };
-                    let (p, q) = (p + lift, q + lift);
-                    k = next_crossing(rs, k, p);
-                    while k < lin.len() && rs[k] < q {
-                        acc[lin[k] as usize] += w * (min(rs[k + 1], q) - max(rs[k], p));
-                        k += 1;
-                    }
-                }
-            }
+            accumulate_whole(cr, sr.dirs.len(), w, seen, &[lift], &mut [acc]);
             return;
         }
         let (a0, a1, b0, b1) = block;
@@ -399,31 +378,33 @@ impl ExactEstimator<'_> {
     }
 }
 
-/// What the rays of one class saw in each rectangle of the whole grid, at
-/// every step `t` (lift `v·t`) into `accs[t − 1]`, times the class's
-/// weight: the whole-grid branch of [`ExactEstimator::accumulate`] for all
-/// the steps in one pass over the rays.
+/// What the `rays` rays of one class saw in each rectangle of the whole
+/// grid, at each lift `lifts[i]` (`v·t`) into `accs[i]`, times the class's
+/// weight `w`. With several lifts (every step of a plan) the rays are read
+/// once, and the crossing of a ray's first interval is found from the
+/// previous lift's; each buffer gets the same sums in the same order as
+/// with one lift at a time.
 fn accumulate_whole(
-    sr: &SourceRays,
-    class: &super::ClassRays,
+    cr: &Crossings,
+    rays: usize,
+    w: f64,
     seen: &RayHits,
-    accs: &mut [Vec<f64>],
+    lifts: &[f64],
+    accs: &mut [&mut [f64]],
 ) {
-    let Some(cr) = &sr.crossings else { return };
-    for m in 0..sr.dirs.len() {
+    for m in 0..rays {
         let (rs, _, lin) = cr.of(m);
         let hits = seen.of(m);
         if hits.is_empty() || lin.is_empty() {
             continue;
         }
         let detected = seen.detected(m);
-        // Where the previous step's first interval started.
+        // Where the previous lift's first interval started.
         let mut hint = usize::MAX;
-        for (t, acc) in accs.iter_mut().enumerate() {
-            // A slice, so its start and length stay in registers across
-            // the stores below.
-            let acc = acc.as_mut_slice();
-            let lift = class.speed * (t + 1) as f64;
+        for (&lift, acc) in lifts.iter().zip(accs.iter_mut()) {
+            // The slice itself, so its start and length stay in registers
+            // across the stores below.
+            let acc: &mut [f64] = acc;
             let end = rs[lin.len()] - lift;
             let from = hits.partition_point(|&(_, q)| q + lift <= rs[0]);
             let mut k = usize::MAX;
@@ -432,9 +413,9 @@ fn accumulate_whole(
                     break;
                 }
                 let w = if detected.is_empty() {
-                    class.weight
+                    w
                 } else {
-                    class.weight * detected[i]
+                    w * detected[i]
                 };
                 let (p, q) = (p + lift, q + lift);
                 k = if k == usize::MAX {
