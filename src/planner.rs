@@ -53,7 +53,7 @@ pub enum Observed {
 }
 
 /// A sensor or target id: a string or a number, echoed back as given.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
 #[serde(untagged)]
 #[schema(examples("a", 7))]
 pub enum Id {
@@ -62,6 +62,38 @@ pub enum Id {
     /// A numeric id.
     #[schema(value_type = f64)]
     Number(serde_json::Number),
+}
+
+/// By hand rather than `untagged`, which buffers every id and, for a
+/// number, first fails (an error message formatted and dropped) as a string.
+impl<'de> Deserialize<'de> for Id {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct IdVisitor;
+        impl serde::de::Visitor<'_> for IdVisitor {
+            type Value = Id;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a string or a number")
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Id, E> {
+                Ok(Id::Text(v.to_owned()))
+            }
+            fn visit_string<E: serde::de::Error>(self, v: String) -> Result<Id, E> {
+                Ok(Id::Text(v))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Id, E> {
+                Ok(Id::Number(v.into()))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Id, E> {
+                Ok(Id::Number(v.into()))
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Id, E> {
+                serde_json::Number::from_f64(v)
+                    .map(Id::Number)
+                    .ok_or_else(|| E::custom("an id must be a finite number"))
+            }
+        }
+        deserializer.deserialize_any(IdVisitor)
+    }
 }
 
 impl Id {
@@ -661,4 +693,42 @@ fn dedup(looks: impl Iterator<Item = (Cell, usize)>) -> Vec<(Cell, usize)> {
         }
     }
     kept
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Id;
+
+    #[test]
+    fn ids_are_strings_or_numbers_echoed_as_given() {
+        for text in [
+            r#""a""#,
+            r#""7""#,
+            "7",
+            "-3",
+            "1.5",
+            "18446744073709551615",
+            "1e3",
+        ] {
+            let id: Id = serde_json::from_str(text).expect(text);
+            let back = serde_json::to_string(&id).expect("serializes");
+            let again: Id = serde_json::from_str(&back).expect("parses back");
+            assert_eq!(again, id, "{text}");
+            // Parsed the way `serde_json` reads the same token.
+            assert_eq!(
+                serde_json::to_value(&id).expect("value"),
+                serde_json::from_str::<serde_json::Value>(text).expect("value"),
+                "{text}"
+            );
+        }
+        assert!(matches!(
+            serde_json::from_str::<Id>(r#""7""#),
+            Ok(Id::Text(_))
+        ));
+        assert!(matches!(serde_json::from_str::<Id>("7"), Ok(Id::Number(_))));
+        for bad in ["true", "null", "[1]", r#"{"a":1}"#] {
+            let err = serde_json::from_str::<Id>(bad).expect_err(bad);
+            assert!(err.to_string().contains("a string or a number"), "{err}");
+        }
+    }
 }

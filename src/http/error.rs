@@ -2,7 +2,7 @@
 //! (`application/problem+json`).
 
 use axum::Json;
-use axum::extract::rejection::{JsonRejection, PathRejection};
+use axum::extract::rejection::{BytesRejection, JsonRejection, PathRejection};
 use axum::http::{HeaderValue, StatusCode, header};
 use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};
@@ -237,8 +237,16 @@ impl ApiError {
 impl IntoResponse for ApiError {
     fn into_response(self) -> Response {
         let status = self.status();
-        if status.is_server_error() {
-            tracing::error!(error = %self, "request failed");
+        match self {
+            // Back-pressure, expected under load and counted in the metrics:
+            // a line per request would add to the overload it reports.
+            ApiError::Overloaded
+            | ApiError::QueueFull { .. }
+            | ApiError::ScenarioNotReady { .. } => {
+                tracing::debug!(error = %self, "request refused");
+            }
+            _ if status.is_server_error() => tracing::error!(error = %self, "request failed"),
+            _ => {}
         }
         let mut res = (status, Json(self.problem())).into_response();
         let headers = res.headers_mut();
@@ -280,6 +288,16 @@ impl From<JsonRejection> for ApiError {
                 ApiError::PayloadTooLarge(other.body_text())
             }
             other => ApiError::MalformedBody(other.body_text()),
+        }
+    }
+}
+
+impl From<BytesRejection> for ApiError {
+    fn from(rejection: BytesRejection) -> Self {
+        if rejection.status() == StatusCode::PAYLOAD_TOO_LARGE {
+            ApiError::PayloadTooLarge(rejection.body_text())
+        } else {
+            ApiError::MalformedBody(rejection.body_text())
         }
     }
 }

@@ -69,7 +69,8 @@ use tower::ServiceBuilder;
 use tower::limit::GlobalConcurrencyLimitLayer;
 use tower_http::cors::{Any, CorsLayer};
 use tower_http::request_id::{MakeRequestUuid, PropagateRequestIdLayer, SetRequestIdLayer};
-use tower_http::trace::TraceLayer;
+use tower_http::trace::{DefaultOnFailure, TraceLayer};
+use tracing::Level;
 
 use self::cache::PlannerCache;
 use self::config::{Config, Settings};
@@ -141,7 +142,7 @@ pub async fn on_rayon<T: Send + 'static>(
         Err(_) => {
             if queue.waiting.fetch_add(1, Ordering::Relaxed) >= queue.max_waiting {
                 queue.waiting.fetch_sub(1, Ordering::Relaxed);
-                metrics::counter!("vigil_http_shed_total").increment(1);
+                count_shed();
                 return Err(ApiError::Overloaded);
             }
             let _waiting = Waiting(&queue.waiting);
@@ -171,6 +172,20 @@ pub async fn on_rayon<T: Send + 'static>(
         Ok(Err(_)) => Err(ApiError::Internal("the planning task panicked".into())),
         Err(_) => Err(ApiError::Internal("the planning task was lost".into())),
     }
+}
+
+/// True when work sent to [`on_rayon`] now would be shed: every worker
+/// busy and the queue full. A hint for shedding a request before its body
+/// is parsed ([`extract::QueuedJson`]); `on_rayon` decides for itself.
+pub(crate) fn queue_full() -> bool {
+    let queue = work_queue();
+    queue.slots.available_permits() == 0
+        && queue.waiting.load(Ordering::Relaxed) >= queue.max_waiting
+}
+
+/// Counts a request shed for load.
+pub(crate) fn count_shed() {
+    metrics::counter!("vigil_http_shed_total").increment(1);
 }
 
 /// State shared by every handler.
@@ -290,7 +305,9 @@ pub fn router(state: AppState) -> Router {
         .fallback(not_found)
         .layer(DefaultBodyLimit::max(MAX_BODY_BYTES))
         .layer(axum::middleware::from_fn(middleware::track))
-        .layer(TraceLayer::new_for_http())
+        // Failures are logged where they are made (`ApiError`), once and
+        // at their level; shed requests (503) not at all above debug.
+        .layer(TraceLayer::new_for_http().on_failure(DefaultOnFailure::new().level(Level::DEBUG)))
         .layer(PropagateRequestIdLayer::x_request_id())
         .layer(SetRequestIdLayer::x_request_id(MakeRequestUuid));
     let app = match cors(&settings.cors_origins) {
@@ -338,7 +355,9 @@ mod tests {
     use std::sync::atomic::{AtomicUsize, Ordering};
     use std::time::Duration;
 
-    use super::{ApiError, QUEUE_PER_WORKER, on_rayon, work_queue};
+    use axum::extract::FromRequest;
+
+    use super::{ApiError, QUEUE_PER_WORKER, extract, on_rayon, queue_full, work_queue};
 
     /// The tests here share rayon's pool and the work queue: one at a time.
     static SERIAL: tokio::sync::Mutex<()> = tokio::sync::Mutex::const_new(());
@@ -376,13 +395,33 @@ mod tests {
         while work_queue().waiting.load(Ordering::SeqCst) < QUEUE_PER_WORKER * workers {
             tokio::time::sleep(Duration::from_millis(1)).await;
         }
-        // The queue is full: the next is shed without waiting.
+        // The queue is full: the next is shed without waiting, and a body
+        // for the queue is not even parsed (this one would be a 400).
         let shed = on_rayon(|| ()).await;
+        assert!(matches!(shed, Err(ApiError::Overloaded)), "{shed:?}");
+        assert!(queue_full());
+        let body = |text: &'static str| {
+            axum::http::Request::builder()
+                .method("POST")
+                .header("content-type", "application/json")
+                .body(axum::body::Body::from(text))
+                .expect("a request")
+        };
+        type Queued = extract::QueuedJson<serde_json::Value>;
+        let shed = Queued::from_request(body("{not json"), &()).await;
         assert!(matches!(shed, Err(ApiError::Overloaded)), "{shed:?}");
         release.store(1, Ordering::SeqCst);
         for task in tasks {
             task.await.expect("joined").expect("queued work runs");
         }
+        assert!(!queue_full());
+        let parsed = Queued::from_request(body("{not json"), &()).await;
+        assert!(
+            matches!(parsed, Err(ApiError::MalformedBody(_))),
+            "{parsed:?}"
+        );
+        let parsed = Queued::from_request(body(r#"{"a": 1}"#), &()).await;
+        assert!(matches!(parsed, Ok(extract::QueuedJson(v)) if v["a"] == 1));
         assert_eq!(
             running.load(Ordering::SeqCst),
             (QUEUE_PER_WORKER + 1) * workers

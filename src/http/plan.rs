@@ -8,7 +8,7 @@ use axum::extract::State;
 
 use super::AppState;
 use super::error::ApiError;
-use super::extract::{Json, Path};
+use super::extract::{Json, Path, QueuedJson};
 use super::middleware::RequestStart;
 use super::openapi::{self as doc, examples};
 
@@ -139,10 +139,10 @@ pub async fn plan(
     State(state): State<AppState>,
     start: Option<Extension<RequestStart>>,
     Path(id): Path<String>,
-    body: Result<Json<PlanRequest>, ApiError>,
+    body: Result<QueuedJson<PlanRequest>, ApiError>,
 ) -> Result<Json<PlanResponse>, ApiError> {
     let planner = state.registry.resolve(&id).await?;
-    let Json(req) = body?;
+    let QueuedJson(req) = body?;
     Ok(Json(plan_on_rayon(&state, start, planner, &req).await?))
 }
 
@@ -181,7 +181,7 @@ pub async fn plan(
 pub async fn plan_inline(
     State(state): State<AppState>,
     start: Option<Extension<RequestStart>>,
-    Json(body): Json<serde_json::Value>,
+    QueuedJson(body): QueuedJson<serde_json::Value>,
 ) -> Result<Json<PlanResponse>, ApiError> {
     let serde_json::Value::Object(mut fields) = body else {
         return Err(ApiError::MalformedBody(

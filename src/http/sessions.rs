@@ -20,7 +20,7 @@ use utoipa::ToSchema;
 
 use super::AppState;
 use super::error::ApiError;
-use super::extract::{Json, Path};
+use super::extract::{Json, Path, QueuedJson};
 use super::middleware::RequestStart;
 use super::openapi::{self as doc, examples};
 use super::plan::{plan_on_rayon, resolve_scenario};
@@ -269,10 +269,10 @@ pub async fn step(
     State(state): State<AppState>,
     start: Option<Extension<RequestStart>>,
     Path(id): Path<String>,
-    body: Result<Json<StepRequest>, ApiError>,
+    body: Result<QueuedJson<StepRequest>, ApiError>,
 ) -> Result<Json<StepResponse>, ApiError> {
     let shared = state.sessions.get(&id)?;
-    let Json(req) = body?;
+    let QueuedJson(req) = body?;
     req.check()?;
     let mut session = shared.lock().await;
     let prepared = session.prepare(&req);
