@@ -234,6 +234,15 @@ impl ApiError {
     }
 }
 
+impl ApiError {
+    /// A JSON body sent without a JSON content type.
+    pub(crate) fn missing_json_content_type() -> Self {
+        ApiError::MalformedBody(
+            "expected a request with `Content-Type: application/json`".to_owned(),
+        )
+    }
+}
+
 impl IntoResponse for ApiError {
     fn into_response(self) -> Response {
         let status = self.status();
@@ -281,9 +290,7 @@ impl From<JsonRejection> for ApiError {
         match rejection {
             JsonRejection::JsonDataError(e) => ApiError::MalformedBody(e.body_text()),
             JsonRejection::JsonSyntaxError(e) => ApiError::MalformedBody(e.body_text()),
-            JsonRejection::MissingJsonContentType(_) => ApiError::MalformedBody(
-                "expected a request with `Content-Type: application/json`".to_owned(),
-            ),
+            JsonRejection::MissingJsonContentType(_) => ApiError::missing_json_content_type(),
             other if other.status() == StatusCode::PAYLOAD_TOO_LARGE => {
                 ApiError::PayloadTooLarge(other.body_text())
             }
