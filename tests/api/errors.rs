@@ -31,12 +31,33 @@ async fn malformed_json_is_400() {
         let res = app.post_raw(path, Some("text/plain"), valid).await;
         assert_problem(res, StatusCode::BAD_REQUEST, "Content-Type").await;
     }
+    // Any `application/*+json` is JSON.
+    let valid = serde_json::to_vec(&plan_request()).unwrap();
+    let res = app
+        .post_raw(
+            "/v1/scenarios/paper-v10/plan",
+            Some("application/vnd.vigil+json; charset=utf-8"),
+            valid,
+        )
+        .await;
+    assert_eq!(res.status(), StatusCode::OK);
 }
 
 #[tokio::test]
 async fn missing_fields_and_wrong_types_are_400() {
     let app = spawn_app().await;
-    let cases: [(&str, Value, &str); 7] = [
+    let cases: [(&str, Value, &str); 9] = [
+        // The detail gives the path to the offending value.
+        (
+            "/v1/scenarios/paper-v10/plan",
+            json!({"sensors": [{"id": 1, "x": 5.0, "y": 5.0}, {"id": 2, "x": "a", "y": 5.0}]}),
+            "sensors[1].x",
+        ),
+        (
+            "/v1/scenarios/paper-v10/plan",
+            json!({"sensors": [{"id": true, "x": 5.0, "y": 5.0}]}),
+            "sensors[0].id: invalid type: boolean `true`, expected a string or a number",
+        ),
         ("/v1/scenarios/paper-v10/plan", json!({}), "sensors"),
         (
             "/v1/scenarios/paper-v10/plan",
