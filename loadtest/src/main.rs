@@ -255,6 +255,10 @@ struct InprocArgs {
     /// Timed plans (or session steps), cycling through the requests.
     #[arg(long, default_value_t = 2000)]
     iterations: usize,
+    /// Sleep this long before each timed plan (stateless plans only), as a
+    /// server's planner idles between requests at a low rate.
+    #[arg(long, default_value_t = 0, conflicts_with = "session")]
+    pause_ms: u64,
     /// Write the figures as JSON to this file.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -348,7 +352,8 @@ fn inproc_cmd(a: &InprocArgs) -> Result<()> {
     }
     let planner = requests::planner_for(&a.workload.scenario)?;
     let reqs = a.workload.requests(a.requests.as_deref())?;
-    let r = inproc::measure(&planner, &reqs, a.iterations)?;
+    let pause = std::time::Duration::from_millis(a.pause_ms);
+    let r = inproc::measure_paced(&planner, &reqs, a.iterations, pause)?;
     println!(
         "in process, {} plans of {} requests (mean {:.1} targets) on {}: median {:.3} ms  p90 {:.3}  p99 {:.3}  mean {:.3}  max {:.3}  => {:.0} plans/s per core",
         r.iterations,
