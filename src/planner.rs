@@ -488,6 +488,7 @@ impl Planner {
         if let Some(grid) = &grid {
             SourceRays::index_crossings(&mut rays, &scenario, grid);
         }
+        SourceRays::index_looks(&mut rays, &scenario);
         progress.advance(1);
         Ok(Planner {
             scenario,

@@ -11,6 +11,7 @@ mod windows;
 
 use rayon::prelude::*;
 
+use rays::{LookKey, look_key};
 pub use rays::{RAYS_PER_PI, RAYS_PER_PI_SQUARE, SourceRays};
 use seen::RayHits;
 use windows::{StepWindows, Window};
@@ -115,9 +116,19 @@ impl<'a> ExactEstimator<'a> {
                     })
             })
             .collect();
+        // Each look's field of view as indexed by the rays, once for all
+        // the classes.
+        let keys: Vec<Vec<Option<LookKey>>> = if rays.iter().any(|r| r.looks.is_some()) {
+            observed
+                .iter()
+                .map(|step| step.iter().map(|l| look_key(scenario, &l.region)).collect())
+                .collect()
+        } else {
+            Vec::new()
+        };
         let seen = classes
             .par_iter()
-            .map(|c| RayHits::new(&rays[c.rays], observed, c.speed))
+            .map(|c| RayHits::new(&rays[c.rays], observed, &keys, c.speed))
             .collect();
 
         let grid = grid.filter(|_| scenario.all_square());

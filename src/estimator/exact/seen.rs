@@ -8,7 +8,7 @@
 //! held the piece that a target there was detected: a target that stayed
 //! unreported is still in the zone with the rest of that probability.
 
-use super::rays::SourceRays;
+use super::rays::{LookKey, SourceRays, slab};
 use super::{max, min};
 use crate::geometry::detection_pieces;
 use crate::scenario::{Look, all_certain};
@@ -29,9 +29,18 @@ pub(super) struct RayHits {
 }
 
 impl RayHits {
-    pub(super) fn new(sr: &SourceRays, observed: &[Vec<Look>], speed: f64) -> Self {
+    /// The seen sets of the rays `sr` for a class of speed `speed`.
+    /// `keys[s][i]` is the key of `observed[s][i]`'s field of view in the
+    /// rays' [`LookCrossings`](super::rays::LookCrossings) (see
+    /// [`look_key`](super::rays::look_key)), or `None`.
+    pub(super) fn new(
+        sr: &SourceRays,
+        observed: &[Vec<Look>],
+        keys: &[Vec<Option<LookKey>>],
+        speed: f64,
+    ) -> Self {
         if observed.iter().all(|step| all_certain(step)) {
-            Self::union(sr, observed, speed)
+            Self::union(sr, observed, keys, speed)
         } else {
             Self::weighted(sr, observed, speed)
         }
@@ -115,7 +124,12 @@ impl RayHits {
     }
 
     /// Seen sets of certain looks: unions of intervals.
-    fn union(sr: &SourceRays, observed: &[Vec<Look>], speed: f64) -> Self {
+    fn union(
+        sr: &SourceRays,
+        observed: &[Vec<Look>],
+        keys: &[Vec<Option<LookKey>>],
+        speed: f64,
+    ) -> Self {
         let mut buf = Vec::new();
         let n = sr.dirs.len();
         let o = sr.source.pos;
@@ -135,8 +149,18 @@ impl RayHits {
                 let Some(region) = regions.get(i).map(|l| &l.region) else {
                     continue;
                 };
-                if let Some((a, b)) = sr.range(region, &mut buf) {
-                    spans.push((a, b, speed * s as f64, region));
+                let shift = speed * s as f64;
+                let key = keys.get(s).and_then(|k| k.get(i).copied().flatten());
+                if let (Some(key), Some(table)) = (key, &sr.looks) {
+                    // Indexed: the same range and intervals, read.
+                    let (a, stored) = table.of(key);
+                    if !stored.is_empty() {
+                        let b = a + stored.len();
+                        spans.push((a, b, shift, region, Some(stored)));
+                        (lo, hi) = (lo.min(a), hi.max(b));
+                    }
+                } else if let Some((a, b)) = sr.range(region, &mut buf) {
+                    spans.push((a, b, shift, region, None));
                     (lo, hi) = (lo.min(a), hi.max(b));
                 }
             }
@@ -145,17 +169,18 @@ impl RayHits {
             }
             open.clear();
             open.resize(hi - lo, EMPTY);
-            for &(a, b, shift, region) in &spans {
+            for &(a, b, shift, region, stored) in &spans {
                 let open = &mut open[a - lo..b - lo];
-                if region.disk.is_none() {
+                if let Some(stored) = stored {
+                    for (j, (&(p, q), cur)) in stored.iter().zip(open).enumerate() {
+                        if p <= q {
+                            extend(cur, (a + j) as u32, p + shift, q + shift, &mut pieces);
+                        }
+                    }
+                } else if region.disk.is_none() {
                     // Slab test, branch-free (no direction component is 0).
-                    let r = &region.rect;
-                    let (x0, x1, y0, y1) = (r.x0 - o.x, r.x1 - o.x, r.y0 - o.y, r.y1 - o.y);
                     for (j, (&(_, inv), cur)) in sr.dirs[a..b].iter().zip(open).enumerate() {
-                        let (tx0, tx1) = (x0 * inv.x, x1 * inv.x);
-                        let (ty0, ty1) = (y0 * inv.y, y1 * inv.y);
-                        let p = max(max(min(tx0, tx1), min(ty0, ty1)), 0.0);
-                        let q = min(max(tx0, tx1), max(ty0, ty1));
+                        let (p, q) = slab(&region.rect, o, inv);
                         if p <= q {
                             extend(cur, (a + j) as u32, p + shift, q + shift, &mut pieces);
                         }
@@ -250,5 +275,108 @@ fn extend(cur: &mut (f64, f64), m: u32, p: f64, q: f64, pieces: &mut Vec<(u32, f
             pieces.push((m, cur.0, cur.1));
         }
         *cur = (p, q);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::rays::{SourceRays, look_key};
+    use super::RayHits;
+    use crate::scenario::{Cell, FovSpec, Look, Scenario, builtins, site_fleet_spec};
+
+    /// The seen sets built from indexed looks are the computed ones, to the
+    /// bit: looks of every field of view (two sizes in `site-fleet`) at
+    /// cells all over the lattice, its corners included, a whole-zone look
+    /// (never indexed), every class's speed.
+    #[test]
+    fn indexed_looks_give_the_computed_seen_sets() {
+        // site-fleet's types detect with 0.9 and 0.6: its seen sets never
+        // read the index, which it therefore does not build. Made certain,
+        // it has two sizes of field of view.
+        let mut certain_fleet = site_fleet_spec();
+        for ty in certain_fleet
+            .sensor_types
+            .iter_mut()
+            .flat_map(|t| t.values_mut())
+        {
+            ty.p_detect = Some(1.0);
+        }
+        certain_fleet.p_detect = Some(1.0);
+        let mut scenarios = builtins();
+        let uncertain = scenarios.pop().expect("site-fleet");
+        let mut rays = SourceRays::for_scenario(&uncertain);
+        SourceRays::index_looks(&mut rays, &uncertain);
+        assert!(rays.iter().all(|r| r.looks.is_none()));
+        scenarios.push(Scenario::new(certain_fleet).expect("valid"));
+        let mut compared = 0;
+        for s in scenarios {
+            let mut rays = SourceRays::for_scenario(&s);
+            SourceRays::index_looks(&mut rays, &s);
+            assert!(rays.iter().all(|r| r.looks.is_some()), "{}", s.id);
+            // Every square field of view at every cell has its key.
+            for (slot, fov) in s.fovs.iter().enumerate() {
+                assert!(matches!(fov, FovSpec::Square { .. }));
+                for k in 0..s.cell_count() {
+                    let region = s.fov_with(*fov, s.centre(s.cell_at(k)));
+                    let key = look_key(&s, &region).expect("a key");
+                    // A smaller field of view may equal a larger one
+                    // clipped: then either key holds the same region.
+                    let (ks, kk) = (key as usize / s.cell_count(), key as usize % s.cell_count());
+                    assert_eq!(s.fov_with(s.fovs[ks], s.centre(s.cell_at(kk))), region);
+                    assert!(ks <= slot);
+                }
+            }
+            assert_eq!(look_key(&s, &s.zone_region()), None);
+            let (cols, rows) = (s.cols, s.rows);
+            let observed: Vec<Vec<Look>> = (0..7)
+                .map(|step: i32| {
+                    let mut looks: Vec<Look> = (0..9)
+                        .map(|i: i32| {
+                            let c = Cell {
+                                col: (i * 7 + step * 3).rem_euclid(cols),
+                                row: (i * 5 + step * 2).rem_euclid(rows),
+                            };
+                            let fov = s.fovs[i as usize % s.fovs.len()];
+                            Look::certain(s.fov_with(fov, s.centre(c)))
+                        })
+                        .collect();
+                    looks.push(Look::certain(
+                        s.fov_with(s.fovs[0], s.centre(Cell { col: 0, row: 0 })),
+                    ));
+                    let far = Cell {
+                        col: cols - 1,
+                        row: rows - 1,
+                    };
+                    looks.push(Look::certain(
+                        s.fov_with(*s.fovs.last().expect("a fov"), s.centre(far)),
+                    ));
+                    if step == 3 {
+                        looks.push(Look::certain(s.zone_region()));
+                    }
+                    looks
+                })
+                .collect();
+            let keys: Vec<Vec<_>> = observed
+                .iter()
+                .map(|step| step.iter().map(|l| look_key(&s, &l.region)).collect())
+                .collect();
+            assert!(keys.iter().flatten().filter(|k| k.is_some()).count() >= 7 * 11);
+            for sr in &rays {
+                for class in s.classes_of(sr.source_index) {
+                    let read = RayHits::new(sr, &observed, &keys, class.speed);
+                    let computed = RayHits::new(sr, &observed, &[], class.speed);
+                    assert_eq!(read.offsets, computed.offsets);
+                    let bits = |h: &RayHits| -> Vec<(u64, u64)> {
+                        h.hits
+                            .iter()
+                            .map(|&(p, q)| (p.to_bits(), q.to_bits()))
+                            .collect()
+                    };
+                    assert_eq!(bits(&read), bits(&computed), "{}", s.id);
+                    compared += read.hits.len();
+                }
+            }
+        }
+        assert!(compared > 3_000, "{compared}");
     }
 }
