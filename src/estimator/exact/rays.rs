@@ -58,7 +58,7 @@ pub struct SourceRays {
 /// interval ([`slab`]; `p > q` for a ray that misses), as the seen sets
 /// compute them for a look there. The looks of a plan are such fields of
 /// view, so the seen sets read their intervals here instead, to the same
-/// bits: a tenth of a plan on the reference workload, for 3 MB held.
+/// bits: 0.57 → 0.49 ms a plan on the reference workload, for 3.2 MB held.
 #[derive(Debug, Clone)]
 pub(super) struct LookCrossings {
     /// Per [`LookKey`]: the first ray of the range, and where its intervals
@@ -84,10 +84,10 @@ impl LookCrossings {
     }
 }
 
-/// The key of `look`'s field of view in [`LookCrossings`], if it is the
-/// field of view of an indexed slot at some cell (the looks of certain
-/// sensors are; a whole-zone look is not). Checked by rebuilding that field of view:
-/// a key is only given for a region equal to the indexed one.
+/// The key of `region` in [`LookCrossings`], if it is the field of view of
+/// an indexed slot at some cell (the looks of certain sensors are; a
+/// whole-zone look is not). Checked by rebuilding that field of view: a key
+/// is only given for a region equal to the indexed one.
 pub(super) fn look_key(s: &Scenario, region: &Region) -> Option<LookKey> {
     if region.disk.is_some() {
         return None;
