@@ -280,9 +280,9 @@ impl SourceRays {
     }
 
     /// Indexes where every ray crosses every cell's square field of view
-    /// of a certain type ([`LookCrossings`]), for scenarios of at most
-    /// [`MAX_INDEXED_LOOKS`] such fields of view (a few MB per source);
-    /// others compute them per plan (the same values, more slowly).
+    /// of a certain type (`LookCrossings`), for scenarios of at most
+    /// `MAX_INDEXED_LOOKS` (16 384) such fields of view, a few MB per
+    /// source; others compute them per plan (the same values, more slowly).
     pub fn index_looks(rays: &mut [SourceRays], s: &Scenario) {
         let indexed = (0..s.fovs.len()).filter(|&slot| indexes(s, slot)).count();
         let keys = s.fovs.len() * s.cell_count();
