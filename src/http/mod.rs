@@ -127,7 +127,7 @@ impl Drop for Waiting<'_> {
 /// Runs CPU work (a plan) on rayon's global pool and awaits its result:
 /// one hop from the async worker straight to the thread that plans, whose
 /// parallel parts then split without further hand-offs (see
-/// [`Planner::plan`]). At most one piece runs per worker; up to
+/// [`Planner::plan`](crate::planner::Planner::plan)). At most one piece runs per worker; up to
 /// [`QUEUE_PER_WORKER`] per worker wait, in arrival order.
 ///
 /// # Errors

@@ -2,7 +2,7 @@
 //! registration survives a restart.
 //!
 //! Two backends, one chosen at start-up:
-//! - [`file`] (the default): one JSON file per scenario in this replica's
+//! - [`file`](mod@file) (the default): one JSON file per scenario in this replica's
 //!   own directory (`--data-dir`). Nothing else to run, but each replica
 //!   has a catalogue of its own.
 //! - [`postgres`] (`--database-url`): one row per scenario in a PostgreSQL

@@ -47,7 +47,7 @@ use crate::stats::Stats;
 /// type's `p_detect`, independently of every other look. A target that was
 /// inside looks and never reported is still unseen with probability
 /// `Π (1 − p)` over them, so each ray's seen set carries, piece by piece,
-/// `1 − Π (1 − p)` instead of 1 (see [`seen`]). At the sensor's own cell
+/// `1 − Π (1 − p)` instead of 1 (see `seen`). At the sensor's own cell
 /// a target counts `p_detect` of the sensor, times `Π (1 − p)` over the
 /// excluded looks that hold it: summed in rank order these marginals give
 /// `1 − Π (1 − p)` over the sensors, the chance that at least one detects

@@ -231,7 +231,7 @@ impl SourceRays {
     }
 
     /// Indexes where every ray crosses `grid`'s rectangles (see
-    /// [`ExactEstimator`]), unless that would take more than about 100 bytes
+    /// [`ExactEstimator`](super::ExactEstimator)), unless that would take more than about 100 bytes
     /// per lattice cell; without the index, plans walk the grid instead
     /// (the same values, more slowly).
     pub fn index_crossings(rays: &mut [SourceRays], s: &Scenario, grid: &ElementaryGrid) {
