@@ -232,9 +232,7 @@ impl ApiError {
             detail,
         }
     }
-}
 
-impl ApiError {
     /// A JSON body sent without a JSON content type.
     pub(crate) fn missing_json_content_type() -> Self {
         ApiError::MalformedBody(
@@ -291,9 +289,7 @@ impl From<JsonRejection> for ApiError {
             JsonRejection::JsonDataError(e) => ApiError::MalformedBody(e.body_text()),
             JsonRejection::JsonSyntaxError(e) => ApiError::MalformedBody(e.body_text()),
             JsonRejection::MissingJsonContentType(_) => ApiError::missing_json_content_type(),
-            other if other.status() == StatusCode::PAYLOAD_TOO_LARGE => {
-                ApiError::PayloadTooLarge(other.body_text())
-            }
+            JsonRejection::BytesRejection(e) => e.into(),
             other => ApiError::MalformedBody(other.body_text()),
         }
     }

@@ -284,7 +284,8 @@ impl SourceRays {
     /// `MAX_INDEXED_LOOKS` (16 384) such fields of view, a few MB per
     /// source; others compute them per plan (the same values, more slowly).
     pub fn index_looks(rays: &mut [SourceRays], s: &Scenario) {
-        let indexed = (0..s.fovs.len()).filter(|&slot| indexes(s, slot)).count();
+        let slots: Vec<bool> = (0..s.fovs.len()).map(|slot| indexes(s, slot)).collect();
+        let indexed = slots.iter().filter(|&&x| x).count();
         let keys = s.fovs.len() * s.cell_count();
         if indexed == 0 || indexed * s.cell_count() > MAX_INDEXED_LOOKS || keys >= u32::MAX as usize
         {
@@ -296,10 +297,10 @@ impl SourceRays {
             let mut start = Vec::with_capacity(keys + 1);
             let mut pq: Vec<(f64, f64)> = Vec::new();
             start.push(0);
-            for (slot, fov) in s.fovs.iter().enumerate() {
+            for (fov, &indexed) in s.fovs.iter().zip(&slots) {
                 for k in 0..s.cell_count() {
                     let region = s.fov_with(*fov, s.centre(s.cell_at(k)));
-                    let range = if indexes(s, slot) {
+                    let range = if indexed {
                         sr.range(&region, &mut buf)
                     } else {
                         None
