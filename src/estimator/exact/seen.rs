@@ -139,7 +139,8 @@ impl RayHits {
         // they come, in a buffer over the track's rays; what is left (about
         // one interval per ray and track) is sorted by ray afterwards.
         let tracks = observed.iter().map(Vec::len).max().unwrap_or(0);
-        let mut pieces: Vec<(u32, f64, f64)> = Vec::new();
+        // About one piece per ray and track: reserved at once, not grown.
+        let mut pieces: Vec<(u32, f64, f64)> = Vec::with_capacity((n * tracks).min(1 << 16));
         let mut open: Vec<(f64, f64)> = Vec::new();
         let mut spans = Vec::with_capacity(observed.len());
         for i in 0..tracks {
