@@ -1,7 +1,8 @@
 //! Property tests over the socket: random bytes, random JSON of random
-//! shape, plausible plan requests with extreme numbers and random scenario
-//! specs, sent to every endpoint. The server must never answer 5xx, every
-//! error must be problem+json, and it must still be healthy afterwards.
+//! shape, plausible plan requests with extreme numbers, random scenario
+//! specs and random session runs, sent to every endpoint. The server must
+//! never answer 5xx, every error must be problem+json, and it must still be
+//! healthy afterwards.
 //!
 //! One server serves every case; proptest runs synchronously, so each case
 //! `block_on`s its request on a shared runtime.
@@ -29,7 +30,7 @@ static SERVER: LazyLock<(Runtime, TestApp)> = LazyLock::new(|| {
 });
 
 /// Every route, with `{id}` filled in, and its methods.
-const ENDPOINTS: [(&str, &str); 9] = [
+const ENDPOINTS: [(&str, &str); 13] = [
     ("GET", "/healthz"),
     ("GET", "/v1/scenarios"),
     ("POST", "/v1/scenarios"),
@@ -39,10 +40,20 @@ const ENDPOINTS: [(&str, &str); 9] = [
     ("POST", "/v1/scenarios/paper-v10/plan"),
     ("POST", "/v1/plan"),
     ("POST", "/v1/scenarios/nope/plan"),
+    ("POST", "/v1/sessions"),
+    ("GET", "/v1/sessions/nope"),
+    ("DELETE", "/v1/sessions/nope"),
+    ("POST", "/v1/sessions/nope/step"),
 ];
 
 /// The POST endpoints that read a JSON body.
-const BODY_ENDPOINTS: [&str; 3] = ["/v1/scenarios", "/v1/scenarios/paper-v10/plan", "/v1/plan"];
+const BODY_ENDPOINTS: [&str; 5] = [
+    "/v1/scenarios",
+    "/v1/scenarios/paper-v10/plan",
+    "/v1/plan",
+    "/v1/sessions",
+    "/v1/sessions/nope/step",
+];
 
 fn runner(cases: u32) -> TestRunner {
     TestRunner::new(Config {
@@ -63,6 +74,16 @@ fn send(
     content_type: Option<&str>,
     body: Vec<u8>,
 ) -> Result<StatusCode, TestCaseError> {
+    exchange(method, path, content_type, body).map(|(status, _)| status)
+}
+
+/// [`send`], also giving the body.
+fn exchange(
+    method: &str,
+    path: &str,
+    content_type: Option<&str>,
+    body: Vec<u8>,
+) -> Result<(StatusCode, String), TestCaseError> {
     let (rt, app) = &*SERVER;
     let method = Method::from_bytes(method.as_bytes()).unwrap();
     let (status, ct, text) = rt.block_on(async {
@@ -104,7 +125,7 @@ fn send(
             text
         );
     }
-    Ok(status)
+    Ok((status, text))
 }
 
 fn send_json(path: &str, body: &Value) -> Result<StatusCode, TestCaseError> {
@@ -162,7 +183,8 @@ fn key() -> impl Strategy<Value = String> {
             "sensors", "targets", "history", "horizon", "estimator", "coordination", "observed",
             "explain", "id", "x", "y", "vx", "vy", "scenario", "scenario_id", "zone", "width",
             "height", "cell_size", "fov", "shape", "half_width", "radius", "target_speed",
-            "sources", "rate", "heading", "name",
+            "sources", "rate", "heading", "name", "detections", "history_steps",
+            "min_separation", "type", "sensor_types", "speeds", "p_detect",
         ])
         .prop_map(str::to_owned),
         1 => "[a-z_]{1,8}",
@@ -541,5 +563,162 @@ fn random_scenario_ids_in_paths() {
             Ok(())
         })
         .unwrap();
+    assert_healthy();
+}
+
+/// A session's settings beside its scenario: mostly valid, sometimes out of
+/// bounds or misspelt.
+fn session_body() -> impl Strategy<Value = Value> {
+    let scenario = prop::sample::select(vec![
+        json!({"scenario_id": "paper-v10"}),
+        json!({"scenario_id": "paper-v10"}),
+        json!({"scenario_id": "site-fleet"}),
+        json!({"scenario_id": "site-fleet"}),
+        json!({"scenario_id": "nope"}),
+        json!({"scenario": {
+            "zone": {"width": 100.0, "height": 100.0},
+            "cell_size": 10.0,
+            "fov": {"shape": "circle", "radius": 15.0},
+            "target_speed": 10.0,
+            "sources": [{"x": -1.0, "y": 50.0, "rate": 0.5}]
+        }}),
+        json!({}),
+        json!({"scenario_id": "paper-v10", "scenario": {}}),
+    ]);
+    let small = prop_oneof![6 => (0..=4i64).prop_map(Value::from), 1 => number()];
+    let settings = (
+        prop::option::of(prop_oneof![6 => (1..=4i64).prop_map(Value::from), 1 => number()]),
+        prop::option::of(prop_oneof![6 => (0..=32i64).prop_map(Value::from), 1 => number()]),
+        prop::option::of(small),
+        prop::option::of(
+            prop_oneof![9 => prop::sample::select(vec!["exact", "paper"]), 1 => Just("bogus")],
+        ),
+        prop::option::of(prop_oneof![
+            9 => prop::sample::select(vec!["none", "priority", "iterated"]),
+            1 => Just("bogus"),
+        ]),
+        prop::option::of(
+            prop_oneof![9 => prop::sample::select(vec!["sensors", "zone"]), 1 => Just("bogus")],
+        ),
+        prop::bool::weighted(0.05),
+    );
+    (scenario, settings).prop_map(
+        |(mut body, (horizon, history, separation, estimator, coordination, observed, extra))| {
+            put(&mut body, "horizon", horizon);
+            put(&mut body, "history_steps", history);
+            put(&mut body, "min_separation", separation);
+            put(&mut body, "estimator", estimator.map(Value::from));
+            put(&mut body, "coordination", coordination.map(Value::from));
+            put(&mut body, "observed", observed.map(Value::from));
+            if extra {
+                body["colour"] = json!("red");
+            }
+            body
+        },
+    )
+}
+
+/// A session's step on a zone of side `extent`: sensors of the built-in
+/// types (and unknown ones), detections with extreme numbers, sometimes a
+/// per-step override out of bounds.
+fn step_body(extent: f64) -> impl Strategy<Value = Value> {
+    let typed = (
+        0.0..=extent,
+        0.0..=extent,
+        prop_oneof![
+            12 => Just(None),
+            2 => prop::sample::select(vec![Some("robot"), Some("drone"), Some("default")]),
+            1 => Just(Some("bogus")),
+        ],
+    );
+    let valid_sensors = prop::collection::vec(typed, 1..5).prop_map(|sensors| {
+        sensors
+            .iter()
+            .enumerate()
+            .map(|(i, &(x, y, ty))| {
+                let mut s = json!({"id": i, "x": x, "y": y});
+                put(&mut s, "type", ty.map(Value::from));
+                s
+            })
+            .collect::<Vec<_>>()
+    });
+    let sensors = prop_oneof![
+        12 => valid_sensors,
+        2 => prop::collection::vec(sensor(extent), 0..6),
+    ];
+    let detections = prop_oneof![
+        8 => prop::collection::vec(target(extent), 0..8),
+        1 => prop::collection::vec(target(extent), 100..300),
+    ];
+    let overrides = (
+        prop::option::of(prop_oneof![6 => (1..=4i64).prop_map(Value::from), 1 => number()]),
+        prop::option::of(prop_oneof![6 => (0..=4i64).prop_map(Value::from), 1 => number()]),
+        prop::option::of(any::<bool>()),
+    );
+    (sensors, detections, overrides).prop_map(
+        |(sensors, detections, (horizon, separation, explain))| {
+            let mut req = json!({"sensors": sensors, "detections": detections});
+            put(&mut req, "horizon", horizon);
+            put(&mut req, "min_separation", separation);
+            put(&mut req, "explain", explain.map(Value::from));
+            req
+        },
+    )
+}
+
+/// The session's step count, from `GET /v1/sessions/{id}`.
+fn session_step(id: &str) -> Result<Value, TestCaseError> {
+    let (status, text) = exchange("GET", &format!("/v1/sessions/{id}"), None, Vec::new())?;
+    prop_assert_eq!(status, StatusCode::OK, "GET /v1/sessions/{}: {}", id, text);
+    let info: Value = serde_json::from_str(&text)
+        .map_err(|e| TestCaseError::fail(format!("session info not JSON ({e}): {text}")))?;
+    Ok(info["step"].clone())
+}
+
+#[test]
+fn random_session_runs() {
+    // A run: open a session, send it steps (some of them bad), read it back
+    // after each; a step that fails records nothing, one that succeeds
+    // records one step. Then delete it, and it is gone.
+    let steps = prop::collection::vec(step_body(300.0), 1..6);
+    let opened = Cell::new(0);
+    let planned = Cell::new(0);
+    runner(60)
+        .run(&(session_body(), steps), |(body, steps)| {
+            let (status, text) = exchange(
+                "POST",
+                "/v1/sessions",
+                Some("application/json"),
+                serde_json::to_vec(&body).unwrap(),
+            )?;
+            if status != StatusCode::CREATED {
+                return Ok(());
+            }
+            opened.set(opened.get() + 1);
+            let info: Value = serde_json::from_str(&text).unwrap();
+            let id = info["id"].as_str().expect("an id").to_owned();
+            let mut done = 0u64;
+            for step in &steps {
+                let status = send_json(&format!("/v1/sessions/{id}/step"), step)?;
+                if status == StatusCode::OK {
+                    done += 1;
+                    planned.set(planned.get() + 1);
+                }
+                prop_assert_eq!(session_step(&id)?, json!(done), "after {}", step);
+            }
+            prop_assert_eq!(
+                send("DELETE", &format!("/v1/sessions/{id}"), None, Vec::new())?,
+                StatusCode::NO_CONTENT
+            );
+            prop_assert_eq!(
+                send_json(&format!("/v1/sessions/{id}/step"), &steps[0])?,
+                StatusCode::NOT_FOUND
+            );
+            Ok(())
+        })
+        .unwrap();
+    // The strategies are meant to reach the planner too.
+    assert!(opened.get() > 0, "no session was opened");
+    assert!(planned.get() > 0, "no step was planned");
     assert_healthy();
 }
