@@ -126,6 +126,7 @@ pub fn coordinate(
     // once and shared by every search it runs.
     let motions: Vec<ValueGrid> = (0..n)
         .into_par_iter()
+        .with_min_len(crate::parallel::min_len())
         .map(|i| {
             let start = starts[i];
             ValueGrid::with_motion(horizon, s.types[types[i]].speed, |dc, dr| {
@@ -160,6 +161,7 @@ pub fn coordinate(
     // Every sensor alone.
     let mut plans: Vec<SensorPlan> = (0..n)
         .into_par_iter()
+        .with_min_len(crate::parallel::min_len())
         .map(|i| plan_one(i, &mut |t, g| est.fill(i, starts[i], t, &[], g), Vec::new()))
         .collect();
     cancel.check()?;

@@ -16,6 +16,8 @@
 //!
 //! [`cancel`] lets the HTTP layer stop a plan nobody waits for, and [`cost`]
 //! predicts what a precomputation or a plan will cost before it starts.
+//! A plan's parallel loops split among rayon's workers only when it runs
+//! on one (`parallel`).
 //! [`http`] is the thin HTTP layer over them, and [`store`] keeps
 //! registered scenarios on disk.
 
@@ -25,6 +27,7 @@ pub mod cost;
 pub mod estimator;
 pub mod geometry;
 pub mod http;
+mod parallel;
 pub mod planner;
 pub mod scenario;
 pub mod search;

@@ -557,8 +557,24 @@ impl Planner {
         cancel: &CancelToken,
     ) -> Result<PlanResponse, Cancelled> {
         if rayon::current_thread_index().is_none() {
-            return rayon::scope(|_| self.plan_cancellable(input, cancel));
+            return rayon::scope(|_| self.plan_here(input, cancel));
         }
+        self.plan_here(input, cancel)
+    }
+
+    /// [`Planner::plan_cancellable`] on the calling thread: on a worker of
+    /// a rayon pool the plan's parallel parts split among its workers; on
+    /// any other thread they run there, one after the other. The answer is
+    /// the same to the last bit either way. For a pool of one thread this
+    /// saves the two thread switches of the hop to it and back.
+    ///
+    /// # Errors
+    /// [`Cancelled`] once `cancel` is cancelled.
+    pub fn plan_here(
+        &self,
+        input: &PlanInput,
+        cancel: &CancelToken,
+    ) -> Result<PlanResponse, Cancelled> {
         cancel.check()?;
         let started = Instant::now();
         let s = &self.scenario;

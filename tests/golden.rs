@@ -4,15 +4,17 @@
 //! recorded requests of a `vigil-sim` run with 16 steps of history, for
 //! every estimator and coordination, are bit for bit the ones recorded in
 //! `tests/golden/paper-builtins.json` before the change (SHA-256 of their
-//! JSON, compute time zeroed), on one, two and three threads alike, and
-//! the ids of stored specs are unchanged.
+//! JSON, compute time zeroed), on one, two and three threads alike and
+//! outside any pool (a one-core server plans on its async worker), and the
+//! ids of stored specs are unchanged.
 //! Fields added since (the minimum separation, 0 for the built-ins, and
 //! its violation counts) must be 0, and are left out of the digest.
 #![allow(clippy::unwrap_used, missing_docs)]
 
 use serde_json::{Value, json};
 use sha2::{Digest, Sha256};
-use vigil::planner::{PlanRequest, Planner};
+use vigil::cancel::CancelToken;
+use vigil::planner::{PlanInput, PlanRequest, Planner};
 use vigil::scenario::{Scenario, ScenarioSpec, builtins};
 
 fn digest(v: &Value) -> String {
@@ -32,8 +34,9 @@ fn strip_separation(resp: &mut Value) {
     }
 }
 
-/// On one, two and three threads: the plans do not depend on how many
-/// cores the replica has.
+/// On one, two and three threads, and on a thread of no pool (the plan's
+/// parallel loops then run there in order): the plans do not depend on how
+/// many cores the replica has.
 #[test]
 fn paper_builtins_answer_exactly_as_before() {
     for threads in [1, 2, 3] {
@@ -41,11 +44,15 @@ fn paper_builtins_answer_exactly_as_before() {
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| check_builtins(threads));
+            .install(|| check_builtins(Some(threads)));
     }
+    assert_eq!(rayon::current_thread_index(), None);
+    check_builtins(None);
 }
 
-fn check_builtins(threads: usize) {
+/// `threads`: the size of the pool planning, or `None` for the calling
+/// thread outside any pool.
+fn check_builtins(threads: Option<usize>) {
     let doc: Value = serde_json::from_str(include_str!("golden/paper-builtins.json")).unwrap();
     let builtins = builtins();
     let mut checked = 0;
@@ -86,13 +93,22 @@ fn check_builtins(threads: usize) {
                 }
             }
             let req: PlanRequest = serde_json::from_value(req).unwrap();
-            let mut resp = serde_json::to_value(planner.plan_request(&req).unwrap()).unwrap();
+            let resp = match threads {
+                Some(_) => planner.plan_request(&req).unwrap(),
+                None => planner
+                    .plan_here(
+                        &PlanInput::new(&planner.scenario, &req).unwrap(),
+                        &CancelToken::never(),
+                    )
+                    .unwrap(),
+            };
+            let mut resp = serde_json::to_value(resp).unwrap();
             resp["compute_micros"] = json!(0);
             strip_separation(&mut resp);
             assert_eq!(
                 digest(&resp),
                 case["response_sha256"],
-                "{id}: case {i} ({}) answers differently on {threads} threads",
+                "{id}: case {i} ({}) answers differently on {threads:?} threads",
                 case["override"]
             );
             checked += 1;

@@ -151,9 +151,28 @@ pub struct Settings {
     pub session_ttl: Duration,
     /// Most sessions held at once.
     pub max_sessions: usize,
+    /// Whether plans predicted under [`INLINE_PLAN_MS`] run on the async
+    /// worker that received them instead of on rayon's pool; `None`: when
+    /// the pool has one thread (one core), where the hop to it and back is
+    /// two thread switches of pure cost.
+    pub inline_plans: Option<bool>,
 }
 
+/// Plans predicted to take at most this many milliseconds of CPU run on the
+/// async worker that received them when the server plans inline
+/// ([`Settings::plans_inline`]): long enough for the reference workload
+/// (~0.5 ms), short enough that the worker's other connections and a
+/// deadline wait little.
+pub const INLINE_PLAN_MS: f64 = 5.0;
+
 impl Settings {
+    /// Whether short plans run on the async worker that received them
+    /// (see [`Settings::inline_plans`]).
+    pub fn plans_inline(&self) -> bool {
+        self.inline_plans
+            .unwrap_or_else(|| rayon::current_num_threads() == 1)
+    }
+
     /// The registry's bounds on precomputation.
     pub fn job_limits(&self) -> super::JobLimits {
         super::JobLimits {
@@ -178,6 +197,7 @@ impl Default for Settings {
             max_plan_ms: Some(2000.0),
             session_ttl: Duration::from_secs(600),
             max_sessions: 10_000,
+            inline_plans: None,
         }
     }
 }
@@ -201,6 +221,7 @@ impl From<&Config> for Settings {
             max_plan_ms: (c.max_plan_ms > 0).then_some(c.max_plan_ms as f64),
             session_ttl: Duration::from_secs(c.session_ttl_s.max(1)),
             max_sessions: c.max_sessions.max(1),
+            inline_plans: None,
         }
     }
 }

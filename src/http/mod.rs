@@ -136,24 +136,7 @@ impl Drop for Waiting<'_> {
 pub async fn on_rayon<T: Send + 'static>(
     work: impl FnOnce() -> T + Send + 'static,
 ) -> Result<T, ApiError> {
-    let queue = work_queue();
-    let permit = match queue.slots.clone().try_acquire_owned() {
-        Ok(permit) => permit,
-        Err(_) => {
-            if queue.waiting.fetch_add(1, Ordering::Relaxed) >= queue.max_waiting {
-                queue.waiting.fetch_sub(1, Ordering::Relaxed);
-                count_shed();
-                return Err(ApiError::Overloaded);
-            }
-            let _waiting = Waiting(&queue.waiting);
-            queue
-                .slots
-                .clone()
-                .acquire_owned()
-                .await
-                .map_err(|_| ApiError::Internal("the work queue is closed".into()))?
-        }
-    };
+    let permit = admit().await?;
     let (tx, rx) = tokio::sync::oneshot::channel();
     rayon::spawn(move || {
         // Held until the work ends, even when the client has left.
@@ -172,6 +155,47 @@ pub async fn on_rayon<T: Send + 'static>(
         Ok(Err(_)) => Err(ApiError::Internal("the planning task panicked".into())),
         Err(_) => Err(ApiError::Internal("the planning task was lost".into())),
     }
+}
+
+/// A place among the workers for one piece of work: at once when one is
+/// free, else after those queued before it, or [`ApiError::Overloaded`]
+/// at once when the queue is full.
+async fn admit() -> Result<tokio::sync::OwnedSemaphorePermit, ApiError> {
+    let queue = work_queue();
+    match queue.slots.clone().try_acquire_owned() {
+        Ok(permit) => Ok(permit),
+        Err(_) => {
+            if queue.waiting.fetch_add(1, Ordering::Relaxed) >= queue.max_waiting {
+                queue.waiting.fetch_sub(1, Ordering::Relaxed);
+                count_shed();
+                return Err(ApiError::Overloaded);
+            }
+            let _waiting = Waiting(&queue.waiting);
+            queue
+                .slots
+                .clone()
+                .acquire_owned()
+                .await
+                .map_err(|_| ApiError::Internal("the work queue is closed".into()))
+        }
+    }
+}
+
+/// Runs short CPU work on this async worker, admitted like [`on_rayon`]'s
+/// (one piece per rayon worker, the same queue and shedding): for a pool of
+/// one thread, the hop to it and back costs two thread switches a request
+/// on a core that does both. Only for work of a few milliseconds: this
+/// worker serves no other request meanwhile, and a deadline cannot stop it
+/// before it ends.
+///
+/// # Errors
+/// As [`on_rayon`].
+pub async fn on_this_worker<T>(work: impl FnOnce() -> T) -> Result<T, ApiError> {
+    let _permit = admit().await?;
+    // The requests that arrived meanwhile queue (or are shed) first.
+    tokio::task::yield_now().await;
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(work))
+        .map_err(|_| ApiError::Internal("the planning task panicked".into()))
 }
 
 /// True when work sent to [`on_rayon`] now would be shed: every worker

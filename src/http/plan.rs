@@ -7,6 +7,7 @@ use axum::Extension;
 use axum::extract::State;
 
 use super::AppState;
+use super::config::INLINE_PLAN_MS;
 use super::error::ApiError;
 use super::extract::{Json, Path, QueuedJson};
 use super::middleware::RequestStart;
@@ -82,19 +83,25 @@ pub(super) async fn plan_on_rayon(
     req: &PlanRequest,
 ) -> Result<PlanResponse, ApiError> {
     let input = PlanInput::new(&planner.scenario, req)?;
-    if let Some(limit_ms) = state.settings.max_plan_ms {
-        let predicted_ms = cost::plan_ms(&planner, &input);
-        if predicted_ms > limit_ms {
-            metrics::counter!("vigil_plans_refused_total", "reason" => "cost").increment(1);
-            return Err(ApiError::PlanTooCostly {
-                predicted_ms,
-                limit_ms,
-            });
-        }
+    let predicted_ms = cost::plan_ms(&planner, &input);
+    if let Some(limit_ms) = state.settings.max_plan_ms
+        && predicted_ms > limit_ms
+    {
+        metrics::counter!("vigil_plans_refused_total", "reason" => "cost").increment(1);
+        return Err(ApiError::PlanTooCostly {
+            predicted_ms,
+            limit_ms,
+        });
     }
     let guard = CancelOnDrop::new("plan", start, state);
     let token = guard.token();
-    let res = super::on_rayon(move || planner.plan_cancellable(&input, &token)).await;
+    let res = if state.settings.plans_inline() && predicted_ms <= INLINE_PLAN_MS {
+        metrics::counter!("vigil_plans_total", "on" => "worker").increment(1);
+        super::on_this_worker(|| planner.plan_here(&input, &token)).await
+    } else {
+        metrics::counter!("vigil_plans_total", "on" => "pool").increment(1);
+        super::on_rayon(move || planner.plan_cancellable(&input, &token)).await
+    };
     guard.finish();
     // A cancelled plan that is still awaited was cancelled by its deadline.
     res?.map_err(|_| ApiError::Timeout)

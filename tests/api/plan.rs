@@ -3,7 +3,7 @@
 use reqwest::StatusCode;
 use serde_json::{Value, json};
 
-use crate::helpers::{close, json_body, plan_request, spawn_app};
+use crate::helpers::{close, json_body, metric, plan_request, spawn_app, spawn_with};
 
 const SIDE: i64 = 30;
 const CELL: f64 = 10.0;
@@ -239,5 +239,103 @@ async fn extreme_but_finite_targets_do_not_fail_the_server() {
                 "{estimator}/{coordination}: {status} {text}"
             );
         }
+    }
+}
+
+/// A plan's answer without its timing.
+fn untimed(mut res: Value) -> Value {
+    res["compute_micros"] = json!(0);
+    res
+}
+
+/// A server that plans on its async workers (as one with a single core
+/// does) answers every request as one that plans on rayon's pool, to the
+/// last bit: every estimator and coordination, history, a fleet's types,
+/// a session's steps. A plan predicted above the inline bound still goes
+/// to the pool; the metric counts where each ran.
+#[tokio::test]
+async fn plans_on_the_async_worker_answer_as_on_the_pool() {
+    use vigil::http::config::{INLINE_PLAN_MS, Settings};
+    let on = |inline| Settings {
+        inline_plans: Some(inline),
+        ..Settings::default()
+    };
+    let (pool, worker) = (spawn_with(on(false)).await, spawn_with(on(true)).await);
+    let mut requests = Vec::new();
+    for estimator in ["exact", "paper"] {
+        for coordination in ["none", "priority", "iterated"] {
+            let mut req = plan_request();
+            req["estimator"] = json!(estimator);
+            req["coordination"] = json!(coordination);
+            req["history"] = json!([[{"x": 40.0, "y": 60.0}, {"x": 250.0, "y": 150.0}],
+                [{"x": 50.0, "y": 60.0}, {"x": 240.0, "y": 150.0}]]);
+            req["explain"] = json!(true);
+            requests.push(("/v1/scenarios/paper-v10/plan", req));
+        }
+    }
+    requests.push((
+        "/v1/scenarios/site-fleet/plan",
+        json!({"sensors": [{"id": "r", "x": 55.0, "y": 55.0, "type": "robot"},
+            {"id": "d", "x": 305.0, "y": 105.0, "type": "drone"}],
+            "targets": [{"x": 60.0, "y": 70.0, "vx": 1.5, "vy": 0.0}],
+            "history": [[{"x": 65.0, "y": 55.0, "type": "robot"}]],
+            "min_separation": 2}),
+    ));
+    for (path, req) in &requests {
+        let a = json_body(pool.post_json(path, req).await, StatusCode::OK).await;
+        let b = json_body(worker.post_json(path, req).await, StatusCode::OK).await;
+        assert_eq!(untimed(a), untimed(b), "{path} {req}");
+    }
+    // The metrics are the process's, shared by every test of this binary;
+    // only this one plans on a worker.
+    let n = requests.len() as f64;
+    let on_worker = || metric(&worker.address, "vigil_plans_total", &["on=\"worker\""]);
+    assert_eq!(on_worker().await, n);
+
+    // A plan predicted above the bound runs on the pool even so.
+    let planner = vigil::planner::Planner::new(
+        vigil::scenario::builtins()
+            .into_iter()
+            .find(|s| s.id == "paper-v10")
+            .unwrap(),
+    );
+    let sensors: Vec<Value> = (0..48)
+        .map(|i| json!({"id": i, "x": 5.0 + f64::from(i % 8) * 40.0, "y": 5.0 + f64::from(i / 8) * 50.0}))
+        .collect();
+    let long = json!({"sensors": sensors, "horizon": 6, "coordination": "iterated"});
+    let input = vigil::planner::PlanInput::new(
+        &planner.scenario,
+        &serde_json::from_value(long.clone()).unwrap(),
+    )
+    .unwrap();
+    assert!(vigil::cost::plan_ms(&planner, &input) > INLINE_PLAN_MS);
+    json_body(worker.plan(&long).await, StatusCode::OK).await;
+    assert_eq!(on_worker().await, n);
+
+    // A session's steps alike.
+    let mut ids = Vec::new();
+    for app in [&pool, &worker] {
+        let res = app
+            .post_json("/v1/sessions", &json!({"scenario_id": "paper-v10"}))
+            .await;
+        let info = json_body(res, StatusCode::CREATED).await;
+        ids.push(info["id"].as_str().unwrap().to_owned());
+    }
+    for step in 0..4 {
+        let shift = 10.0 * f64::from(step);
+        let body = json!({"sensors": [{"id": "a", "x": 55.0 + shift, "y": 55.0},
+                {"id": "b", "x": 245.0, "y": 60.0 + shift}],
+            "detections": [{"id": step, "x": 60.0 + shift, "y": 40.0, "vx": 10.0, "vy": 0.0}]});
+        let a = pool
+            .post_json(&format!("/v1/sessions/{}/step", ids[0]), &body)
+            .await;
+        let b = worker
+            .post_json(&format!("/v1/sessions/{}/step", ids[1]), &body)
+            .await;
+        let (a, b) = (
+            json_body(a, StatusCode::OK).await,
+            json_body(b, StatusCode::OK).await,
+        );
+        assert_eq!(untimed(a), untimed(b), "step {step}");
     }
 }

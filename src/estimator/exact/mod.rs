@@ -128,6 +128,7 @@ impl<'a> ExactEstimator<'a> {
         };
         let seen = classes
             .par_iter()
+            .with_min_len(crate::parallel::min_len())
             .map(|c| RayHits::new(&rays[c.rays], observed, &keys, c.speed))
             .collect();
 
@@ -173,10 +174,12 @@ impl<'a> ExactEstimator<'a> {
             .enumerate()
             .flat_map(|(t, w)| (0..w.blocks.len()).map(move |slot| (t, slot)))
             .collect();
-        jobs.par_iter().for_each(|&(t, slot)| {
-            let step = &self.windows[t];
-            step.built[slot].get_or_init(|| self.window(grid, step.blocks[slot], t + 1));
-        });
+        jobs.par_iter()
+            .with_min_len(crate::parallel::min_len())
+            .for_each(|&(t, slot)| {
+                let step = &self.windows[t];
+                step.built[slot].get_or_init(|| self.window(grid, step.blocks[slot], t + 1));
+            });
     }
 
     /// The window serving `sensor` at step `t`, if the fast path applies.

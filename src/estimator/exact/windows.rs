@@ -145,6 +145,7 @@ impl ExactEstimator<'_> {
             .classes
             .par_chunks(CLASSES_PER_BUFFER)
             .zip(self.seen.par_chunks(CLASSES_PER_BUFFER))
+            .with_min_len(crate::parallel::min_len())
             .map(|(classes, seen)| {
                 let mut acc = vec![0.0; na * nb];
                 for (class, seen) in classes.iter().zip(seen) {
@@ -200,6 +201,7 @@ impl ExactEstimator<'_> {
             .classes
             .par_chunks(CLASSES_PER_BUFFER)
             .zip(self.seen.par_chunks(CLASSES_PER_BUFFER))
+            .with_min_len(crate::parallel::min_len())
             .map(|(classes, seen)| {
                 let mut accs = vec![vec![0.0; nx * ny]; steps];
                 for (class, seen) in classes.iter().zip(seen) {
