@@ -538,6 +538,9 @@ impl Planner {
     /// Runs on a worker of rayon's global pool (moving there first when
     /// called from outside it), so the plan's parallel parts split among
     /// the workers without handing work back and forth between threads.
+    /// With a global pool of one thread (one core) it runs where it is
+    /// called instead ([`Planner::plan_here`]): the same answer, without
+    /// the two thread switches of the move.
     pub fn plan(&self, input: &PlanInput) -> PlanResponse {
         match self.plan_cancellable(input, &CancelToken::never()) {
             Ok(response) => response,
@@ -556,7 +559,7 @@ impl Planner {
         input: &PlanInput,
         cancel: &CancelToken,
     ) -> Result<PlanResponse, Cancelled> {
-        if rayon::current_thread_index().is_none() {
+        if rayon::current_thread_index().is_none() && rayon::current_num_threads() > 1 {
             return rayon::scope(|_| self.plan_here(input, cancel));
         }
         self.plan_here(input, cancel)
