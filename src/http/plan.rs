@@ -75,8 +75,10 @@ impl Drop for CancelOnDrop {
 }
 
 /// Validates `req`, refuses it if its predicted cost is above the limit,
-/// and plans it on rayon, cancelled as soon as nobody waits for it.
-pub(super) async fn plan_on_rayon(
+/// and plans it once admitted to the planning queue: on rayon, cancelled as
+/// soon as nobody waits for it, or (a short plan on a server that plans
+/// inline) on this async worker.
+pub(super) async fn plan_admitted(
     state: &AppState,
     start: Option<Extension<RequestStart>>,
     planner: Arc<Planner>,
@@ -150,7 +152,7 @@ pub async fn plan(
 ) -> Result<Json<PlanResponse>, ApiError> {
     let planner = state.registry.resolve(&id).await?;
     let QueuedJson(req) = body?;
-    Ok(Json(plan_on_rayon(&state, start, planner, &req).await?))
+    Ok(Json(plan_admitted(&state, start, planner, &req).await?))
 }
 
 /// `POST /v1/plan`: the body of `/v1/scenarios/{id}/plan` plus either
@@ -200,7 +202,7 @@ pub async fn plan_inline(
     let req: PlanRequest = serde_json::from_value(serde_json::Value::Object(fields))
         .map_err(|e| ApiError::MalformedBody(e.to_string()))?;
     let planner = resolve_scenario(&state, start, scenario_id, inline).await?;
-    Ok(Json(plan_on_rayon(&state, start, planner, &req).await?))
+    Ok(Json(plan_admitted(&state, start, planner, &req).await?))
 }
 
 /// The planner of the scenario a body names: `scenario_id` (registered,

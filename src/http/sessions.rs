@@ -23,7 +23,7 @@ use super::error::ApiError;
 use super::extract::{Json, Path, QueuedJson};
 use super::middleware::RequestStart;
 use super::openapi::{self as doc, examples};
-use super::plan::{plan_on_rayon, resolve_scenario};
+use super::plan::{plan_admitted, resolve_scenario};
 use crate::planner::{MAX_TARGETS, PlanResponse};
 use crate::scenario::{MAX_HORIZON, ValidationError};
 use crate::separation::MAX_MIN_SEPARATION;
@@ -286,7 +286,7 @@ pub async fn step(
         )
         .into());
     }
-    let plan = plan_on_rayon(&state, start, session.planner().clone(), &prepared.request).await?;
+    let plan = plan_admitted(&state, start, session.planner().clone(), &prepared.request).await?;
     let step = session.step();
     session.commit(prepared);
     Ok(Json(StepResponse { step, plan }))

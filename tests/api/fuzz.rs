@@ -251,6 +251,26 @@ fn position(extent: f64) -> impl Strategy<Value = Value> {
     (coordinate(extent), coordinate(extent)).prop_map(|(x, y)| json!({"x": x, "y": y}))
 }
 
+/// An optional enum field: absent, one of `valid`, or now and then a
+/// value it does not know.
+fn option(valid: &[&'static str]) -> impl Strategy<Value = Option<&'static str>> {
+    prop::option::of(prop_oneof![
+        9 => prop::sample::select(valid.to_vec()),
+        1 => Just("bogus"),
+    ])
+}
+
+/// A small inline scenario (100×100, circular fields of view).
+fn small_inline_spec() -> Value {
+    json!({
+        "zone": {"width": 100.0, "height": 100.0},
+        "cell_size": 10.0,
+        "fov": {"shape": "circle", "radius": 15.0},
+        "target_speed": 10.0,
+        "sources": [{"x": -1.0, "y": 50.0, "rate": 0.5}]
+    })
+}
+
 /// Sets `key` in `obj` when `value` is `Some`.
 fn put(obj: &mut Value, key: &str, value: Option<Value>) {
     if let Some(v) = value {
@@ -293,16 +313,9 @@ fn plan_request(extent: f64) -> impl Strategy<Value = Value> {
     ]);
     let options = (
         prop::option::of(prop_oneof![6 => (1..=12i64).prop_map(Value::from), 1 => number()]),
-        prop::option::of(
-            prop_oneof![9 => prop::sample::select(vec!["exact", "paper"]), 1 => Just("bogus")],
-        ),
-        prop::option::of(prop_oneof![
-            9 => prop::sample::select(vec!["none", "priority", "iterated"]),
-            1 => Just("bogus"),
-        ]),
-        prop::option::of(
-            prop_oneof![9 => prop::sample::select(vec!["sensors", "zone"]), 1 => Just("bogus")],
-        ),
+        option(&["exact", "paper"]),
+        option(&["none", "priority", "iterated"]),
+        option(&["sensors", "zone"]),
         prop::option::of(any::<bool>()),
     );
     (sensors, targets, history, options).prop_map(
@@ -462,13 +475,7 @@ fn random_json_to_every_body_endpoint() {
 #[test]
 fn plausible_plan_requests() {
     // paper-v10 is 300×300; by path, by id, and with a small inline scenario.
-    let inline = json!({
-        "zone": {"width": 100.0, "height": 100.0},
-        "cell_size": 10.0,
-        "fov": {"shape": "circle", "radius": 15.0},
-        "target_speed": 10.0,
-        "sources": [{"x": -1.0, "y": 50.0, "rate": 0.5}]
-    });
+    let inline = small_inline_spec();
     let route = prop::sample::select(vec![0u8, 1, 2]);
     let ok = Cell::new(0);
     runner(60)
@@ -575,13 +582,7 @@ fn session_body() -> impl Strategy<Value = Value> {
         json!({"scenario_id": "site-fleet"}),
         json!({"scenario_id": "site-fleet"}),
         json!({"scenario_id": "nope"}),
-        json!({"scenario": {
-            "zone": {"width": 100.0, "height": 100.0},
-            "cell_size": 10.0,
-            "fov": {"shape": "circle", "radius": 15.0},
-            "target_speed": 10.0,
-            "sources": [{"x": -1.0, "y": 50.0, "rate": 0.5}]
-        }}),
+        json!({"scenario": small_inline_spec()}),
         json!({}),
         json!({"scenario_id": "paper-v10", "scenario": {}}),
     ]);
@@ -590,16 +591,9 @@ fn session_body() -> impl Strategy<Value = Value> {
         prop::option::of(prop_oneof![6 => (1..=4i64).prop_map(Value::from), 1 => number()]),
         prop::option::of(prop_oneof![6 => (0..=32i64).prop_map(Value::from), 1 => number()]),
         prop::option::of(small),
-        prop::option::of(
-            prop_oneof![9 => prop::sample::select(vec!["exact", "paper"]), 1 => Just("bogus")],
-        ),
-        prop::option::of(prop_oneof![
-            9 => prop::sample::select(vec!["none", "priority", "iterated"]),
-            1 => Just("bogus"),
-        ]),
-        prop::option::of(
-            prop_oneof![9 => prop::sample::select(vec!["sensors", "zone"]), 1 => Just("bogus")],
-        ),
+        option(&["exact", "paper"]),
+        option(&["none", "priority", "iterated"]),
+        option(&["sensors", "zone"]),
         prop::bool::weighted(0.05),
     );
     (scenario, settings).prop_map(
