@@ -44,6 +44,12 @@ pub struct SourceRays {
     pub(super) step: f64,
     /// Unit direction and its componentwise inverse, per ray.
     pub(super) dirs: Vec<(Point, Point)>,
+    /// Per ray, a distance past which it is out of the zone for good: where
+    /// it leaves the zone, plus a margin for rounding (`+∞` for a ray that
+    /// misses the zone). A seen interval that starts past it is out of the
+    /// zone at every step, so the seen sets leave it out (see
+    /// [`RayHits`](super::seen::RayHits)).
+    pub(super) beyond: Vec<f64>,
     /// Index of the source in the scenario.
     pub(super) source_index: usize,
     /// Where each ray crosses the elementary grid, when indexed.
@@ -210,11 +216,21 @@ impl SourceRays {
                 // No component exactly 0, so slab intersections need no
                 // special case (a tilt of 1e-12 rad changes nothing).
                 let nudge = |c: f64| if c == 0.0 { 1e-12 } else { c };
-                let dirs = (0..n)
+                let dirs: Vec<(Point, Point)> = (0..n)
                     .map(|m| {
                         let d = src.direction(lo + (m as f64 + 0.5) * step);
                         let d = Point::new(nudge(d.x), nudge(d.y));
                         (d, Point::new(1.0 / d.x, 1.0 / d.y))
+                    })
+                    .collect();
+                // Every distance the estimator clips a seen interval to (a
+                // cell's, a block's, the zone's far side) is at most the
+                // zone's exit, to rounding: a relative 1e-9 is far more.
+                let beyond = dirs
+                    .iter()
+                    .map(|&(d, inv)| {
+                        zone.ray(src.pos, d, inv)
+                            .map_or(f64::INFINITY, |(_, r1)| r1 + 1e-9 * (1.0 + r1.abs()))
                     })
                     .collect();
                 Some(SourceRays {
@@ -222,6 +238,7 @@ impl SourceRays {
                     lo,
                     step,
                     dirs,
+                    beyond,
                     source_index: j,
                     crossings: None,
                     looks: None,
@@ -331,7 +348,7 @@ impl SourceRays {
 
     /// Approximate heap memory held, bytes.
     pub fn memory_bytes(&self) -> usize {
-        std::mem::size_of::<(Point, Point)>() * self.dirs.len()
+        (std::mem::size_of::<(Point, Point)>() + 8) * self.dirs.len()
             + self.crossings.as_ref().map_or(0, |c| {
                 4 * c.offsets.len() + 8 * c.r.len() + 8 * c.cells.len()
             })
