@@ -351,12 +351,16 @@ impl ExactEstimator<'_> {
         let xc: Vec<f64> = (a0..a1)
             .map(|a| 0.5 * (grid.xs[a] + grid.xs[a + 1]))
             .collect();
+        // The excluded looks across each row, in their order (one buffer).
+        let mut rows: Vec<&Look> = Vec::with_capacity(excluded.len());
         for (j, b) in (b0..b1).enumerate() {
             let yc = 0.5 * (grid.ys[b] + grid.ys[b + 1]);
-            let rows: Vec<&Look> = excluded
-                .iter()
-                .filter(|x| yc >= x.region.rect.y0 && yc <= x.region.rect.y1)
-                .collect();
+            rows.clear();
+            rows.extend(
+                excluded
+                    .iter()
+                    .filter(|x| yc >= x.region.rect.y0 && yc <= x.region.rect.y1),
+            );
             let mut row = 0.0;
             for (i, a) in (a0..a1).enumerate() {
                 let mut miss = 1.0;
