@@ -269,9 +269,9 @@ impl RayHits {
 }
 
 /// [`extend`] over the stored intervals of consecutive rays from `first`,
-/// shifted by `shift`, skipping those that start `beyond`. Kept apart, with
-/// the move to `pieces` out of line, so that the loop's values stay in
-/// registers.
+/// shifted by `shift`, skipping those that start `beyond`. Kept apart (and
+/// [`extend`]'s move to `pieces` out of line) so that the loop's values
+/// stay in registers.
 #[inline(never)]
 fn merge_stored(
     stored: &[(f64, f64)],
@@ -283,13 +283,7 @@ fn merge_stored(
 ) {
     for (m, ((&(p, q), &far), cur)) in (first..).zip(stored.iter().zip(beyond).zip(open)) {
         if p <= q && p + shift <= far {
-            let (p, q) = (p + shift, q + shift);
-            if p <= cur.1 && q >= cur.0 {
-                *cur = (min(cur.0, p), max(cur.1, q));
-            } else {
-                flush(cur, m, pieces);
-                *cur = (p, q);
-            }
+            extend(cur, m, p + shift, q + shift, pieces);
         }
     }
 }
@@ -308,14 +302,12 @@ const EMPTY: (f64, f64) = (f64::INFINITY, f64::NEG_INFINITY);
 
 /// Extends `cur`, ray `m`'s interval being merged, by `[p, q]` when they
 /// overlap; otherwise moves `cur` to `pieces` and starts again from `[p, q]`.
-#[inline]
+#[inline(always)]
 fn extend(cur: &mut (f64, f64), m: u32, p: f64, q: f64, pieces: &mut Vec<(u32, f64, f64)>) {
     if p <= cur.1 && q >= cur.0 {
         *cur = (min(cur.0, p), max(cur.1, q));
     } else {
-        if cur.0 <= cur.1 {
-            pieces.push((m, cur.0, cur.1));
-        }
+        flush(cur, m, pieces);
         *cur = (p, q);
     }
 }
