@@ -72,6 +72,10 @@ pub(super) struct LookCrossings {
     first: Vec<u32>,
     start: Vec<u32>,
     pq: Vec<(f64, f64)>,
+    /// Per [`LookKey`]: how far its intervals must be pushed (at least,
+    /// less a margin for rounding) to start past the exit of every ray
+    /// they lie on ([`SourceRays::beyond`]); `+∞` when never.
+    past: Vec<f64>,
 }
 
 /// A cell's field of view in [`LookCrossings`]: `slot · cells + index`.
@@ -87,6 +91,15 @@ impl LookCrossings {
             self.first[k] as usize,
             &self.pq[self.start[k] as usize..self.start[k + 1] as usize],
         )
+    }
+
+    /// True when the look `key`, its intervals pushed by `shift`, starts
+    /// past the exit of every ray it lies on: the seen sets would leave
+    /// each one out, so they skip it whole (a look seen long ago, far
+    /// downstream of a source: many of a long history's).
+    #[inline]
+    pub(super) fn past_exit(&self, key: LookKey, shift: f64) -> bool {
+        shift > self.past[key as usize]
     }
 }
 
@@ -313,6 +326,7 @@ impl SourceRays {
             let mut first = Vec::with_capacity(keys);
             let mut start = Vec::with_capacity(keys + 1);
             let mut pq: Vec<(f64, f64)> = Vec::new();
+            let mut past = Vec::with_capacity(keys);
             start.push(0);
             for (fov, &indexed) in s.fovs.iter().zip(&slots) {
                 for k in 0..s.cell_count() {
@@ -339,11 +353,36 @@ impl SourceRays {
                     a += lead;
                     first.push(a as u32);
                     start.push(pq.len() as u32);
+                    // A ray's interval pushed by `shift` is left out when
+                    // `p + shift > beyond`. Rounding moves either side by far
+                    // less than the margin (1e-9 of the distances), so past
+                    // `past` every ray's is, whatever the rounding.
+                    let far = pq[from..]
+                        .iter()
+                        .zip(&sr.beyond[a..])
+                        .filter(|((p, q), _)| p <= q)
+                        .map(|(&(p, _), &far)| (far - p) + 1e-9 * (far.abs() + p.abs()));
+                    past.push(far.fold(f64::NEG_INFINITY, f64::max).max(0.0) * (1.0 + 1e-9));
                 }
             }
             pq.shrink_to_fit();
-            sr.looks = Some(LookCrossings { first, start, pq });
+            sr.looks = Some(LookCrossings {
+                first,
+                start,
+                pq,
+                past,
+            });
         });
+    }
+
+    /// These rays as if no ray left the zone: their seen sets keep what
+    /// lies past the exit (to check that leaving it out changes nothing).
+    #[cfg(test)]
+    pub(super) fn keep_past_the_exit(&mut self) {
+        self.beyond.iter_mut().for_each(|b| *b = f64::INFINITY);
+        if let Some(looks) = &mut self.looks {
+            looks.past.iter_mut().for_each(|p| *p = f64::INFINITY);
+        }
     }
 
     /// Approximate heap memory held, bytes.
@@ -353,7 +392,7 @@ impl SourceRays {
                 4 * c.offsets.len() + 8 * c.r.len() + 8 * c.cells.len()
             })
             + self.looks.as_ref().map_or(0, |l| {
-                4 * l.first.len() + 4 * l.start.len() + 16 * l.pq.len()
+                4 * l.first.len() + 4 * l.start.len() + 16 * l.pq.len() + 8 * l.past.len()
             })
     }
 

@@ -25,7 +25,9 @@ use crate::scenario::{Look, all_certain};
 /// the reference workload. Every use clips the seen set to a part of the
 /// zone, and pushing moves it further out, so no value changes, to the bit:
 /// an interval left out covers nothing in the zone, and one it would have
-/// merged with already reaches past the exit.
+/// merged with already reaches past the exit. An indexed look whose every
+/// interval starts past the exit is skipped whole
+/// ([`LookCrossings::past_exit`](super::rays::LookCrossings::past_exit)).
 pub(super) struct RayHits {
     /// `hits[offsets[m]..offsets[m+1]]` are ray `m`'s intervals.
     offsets: Vec<u32>,
@@ -160,6 +162,9 @@ impl RayHits {
                 let shift = speed * s as f64;
                 let key = keys.get(s).and_then(|k| k.get(i).copied().flatten());
                 if let (Some(key), Some(table)) = (key, &sr.looks) {
+                    if table.past_exit(key, shift) {
+                        continue;
+                    }
                     // Indexed: the same range and intervals, read.
                     let (a, stored) = table.of(key);
                     if !stored.is_empty() {
@@ -323,12 +328,13 @@ mod tests {
     use crate::stats::Stats;
 
     /// Leaving out the seen intervals that start past a ray's exit from the
-    /// zone changes no value, to the bit: every built-in (`site-fleet`'s
+    /// zone (and skipping the looks whose every interval does) changes no
+    /// value, to the bit: every built-in (`site-fleet`'s
     /// uncertain looks too), a long history that pushes many intervals out,
     /// by the windows and by the rays, with and without excluded looks.
     #[test]
     fn intervals_past_the_exit_change_no_value() {
-        let mut dropped = 0;
+        let (mut dropped, mut skipped) = (0, 0);
         for s in builtins() {
             let stats: Vec<Stats> = s.fovs.iter().map(|&f| Stats::for_fov(&s, f)).collect();
             let grid = ElementaryGrid::new(&s).expect("squares");
@@ -336,9 +342,7 @@ mod tests {
             SourceRays::index_crossings(&mut rays, &s, &grid);
             SourceRays::index_looks(&mut rays, &s);
             let mut kept = rays.clone();
-            for sr in &mut kept {
-                sr.beyond.iter_mut().for_each(|b| *b = f64::INFINITY);
-            }
+            kept.iter_mut().for_each(SourceRays::keep_past_the_exit);
             let (cols, rows) = (s.cols, s.rows);
             let starts: Vec<Cell> = (0..6)
                 .map(|i: i32| Cell {
@@ -383,6 +387,20 @@ mod tests {
             for (a, b) in est.seen.iter().zip(&all.seen) {
                 dropped += b.hits.len() - a.hits.len();
             }
+            // Whole looks are skipped too, without reading their rays.
+            for sr in rays.iter().filter(|sr| sr.looks.is_some()) {
+                let table = sr.looks.as_ref().expect("indexed");
+                for class in s.classes_of(sr.source_index) {
+                    for (step, looks) in observed.iter().enumerate() {
+                        let shift = class.speed * step as f64;
+                        skipped += looks
+                            .iter()
+                            .filter_map(|l| look_key(&s, &l.region))
+                            .filter(|&key| table.past_exit(key, shift))
+                            .count();
+                    }
+                }
+            }
             for i in 0..starts.len() {
                 let other = (i + 1) % starts.len();
                 let excluded = [s.look(types[other], starts[other])];
@@ -402,6 +420,7 @@ mod tests {
             }
         }
         assert!(dropped > 100, "{dropped}");
+        assert!(skipped > 100, "{skipped}");
     }
 
     /// The seen sets built from indexed looks are the computed ones, to the
