@@ -168,8 +168,10 @@ pub fn coordinate(
     let mut order: Vec<usize> = (0..n).collect();
     // Stable sort: ties keep request order.
     order.sort_by(|&a, &b| plans[b].value.total_cmp(&plans[a].value));
-    // Without coordination but apart, each sensor keeps its lone values.
-    let alone: Vec<ValueGrid> = if mode == Coordination::None && d > 0 {
+    // Each sensor's lone values: without coordination but apart it keeps
+    // them, and at a step where no higher-ranked look comes near its reach
+    // its values against them are these (the same fill, of no looks).
+    let alone: Vec<ValueGrid> = if mode != Coordination::None || d > 0 {
         plans.iter().map(|p| p.grid.clone()).collect()
     } else {
         Vec::new()
@@ -195,7 +197,10 @@ pub fn coordinate(
             let looks = looks_by_step(s, plans, types, above, horizon, i, starts[i]);
             plan_one(
                 i,
-                &mut |t, g| est.fill(i, starts[i], t, &looks[t - 1], g),
+                &mut |t, g| match &looks[t - 1][..] {
+                    [] => g.copy_step(t, &alone[i]),
+                    near => est.fill(i, starts[i], t, near, g),
+                },
                 avoid,
             )
         }

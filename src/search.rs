@@ -459,6 +459,24 @@ impl ValueGrid {
         }
     }
 
+    /// Sets step `t`'s values to `other`'s, a grid of the same motion
+    /// (a clone of one, as every search of a sensor is).
+    ///
+    /// # Panics
+    /// If `other` does not share this grid's motion.
+    pub fn copy_step(&mut self, t: usize, other: &ValueGrid) {
+        assert!(
+            Arc::ptr_eq(&self.motion, &other.motion),
+            "grids of different motions"
+        );
+        if t == 0 || t > self.horizon() {
+            return;
+        }
+        let n = self.side() * self.side();
+        let steps = (t - 1) * n..t * n;
+        self.values[steps.clone()].copy_from_slice(&other.values[steps]);
+    }
+
     fn slot(&self, t: usize, dc: i32, dr: i32) -> Option<usize> {
         if t == 0 || t > self.horizon() {
             return None;

@@ -462,3 +462,31 @@ fn violations_are_clipped_and_cleared() {
     assert!(!g.has_violations());
     assert_eq!(g.violations(1, -1, 0), 0);
 }
+
+#[test]
+fn copy_step_copies_one_step_of_a_clone() {
+    let base = ValueGrid::with_motion(3, 2, |dc, dr| (dc, dr) != (1, 0));
+    let mut from = base.clone();
+    for t in 1..=3 {
+        from.fill_step(t, |dc, dr| Some(f64::from(dc * 10 + dr) + t as f64 / 8.0));
+    }
+    let mut to = base.clone();
+    to.copy_step(2, &from);
+    for t in 1..=3 {
+        for dr in -6..=6 {
+            for dc in -6..=6 {
+                let want = if t == 2 { from.get(t, dc, dr) } else { None };
+                assert_eq!(to.get(t, dc, dr), want, "t={t} ({dc},{dr})");
+            }
+        }
+    }
+    assert!(to.get(2, 2, 1).is_some());
+}
+
+#[test]
+#[should_panic(expected = "different motions")]
+fn copy_step_refuses_another_motion() {
+    let mut a = ValueGrid::with_motion(3, 1, |_, _| true);
+    let b = ValueGrid::with_motion(3, 1, |dc, _| dc != 1);
+    a.copy_step(1, &b);
+}
