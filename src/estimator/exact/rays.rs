@@ -74,7 +74,8 @@ pub(super) struct LookCrossings {
     pq: Vec<(f64, f64)>,
     /// Per [`LookKey`]: how far its intervals must be pushed (at least,
     /// less a margin for rounding) to start past the exit of every ray
-    /// they lie on ([`SourceRays::beyond`]); `+∞` when never.
+    /// they lie on ([`SourceRays::beyond`]); `+∞` when never (a ray that
+    /// never leaves the zone), 0 for a look that meets no ray.
     past: Vec<f64>,
 }
 
@@ -357,12 +358,12 @@ impl SourceRays {
                     // `p + shift > beyond`. Rounding moves either side by far
                     // less than the margin (1e-9 of the distances), so past
                     // `past` every ray's is, whatever the rounding.
-                    let far = pq[from..]
+                    let pushes = pq[from..]
                         .iter()
                         .zip(&sr.beyond[a..])
                         .filter(|((p, q), _)| p <= q)
                         .map(|(&(p, _), &far)| (far - p) + 1e-9 * (far.abs() + p.abs()));
-                    past.push(far.fold(f64::NEG_INFINITY, f64::max).max(0.0) * (1.0 + 1e-9));
+                    past.push(pushes.fold(f64::NEG_INFINITY, f64::max).max(0.0) * (1.0 + 1e-9));
                 }
             }
             pq.shrink_to_fit();
