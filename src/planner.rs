@@ -695,7 +695,8 @@ impl Planner {
 /// Two sensors of the same type on one cell take one look: they see the
 /// same targets at once.
 fn dedup(looks: impl Iterator<Item = (Cell, usize)>) -> Vec<(Cell, usize)> {
-    let mut kept: Vec<(Cell, usize)> = Vec::new();
+    // As many as come, as a rule: one allocation, not one per doubling.
+    let mut kept: Vec<(Cell, usize)> = Vec::with_capacity(looks.size_hint().0);
     let mut seen = HashSet::new();
     for look in looks {
         // A scan for a fleet's few looks (a hash per look cost 2 % of a
