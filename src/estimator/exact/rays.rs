@@ -363,7 +363,7 @@ impl SourceRays {
                         .zip(&sr.beyond[a..])
                         .filter(|((p, q), _)| p <= q)
                         .map(|(&(p, _), &far)| (far - p) + 1e-9 * (far.abs() + p.abs()));
-                    past.push(pushes.fold(f64::NEG_INFINITY, f64::max).max(0.0) * (1.0 + 1e-9));
+                    past.push(pushes.fold(0.0, f64::max));
                 }
             }
             pq.shrink_to_fit();

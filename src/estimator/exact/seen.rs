@@ -388,8 +388,7 @@ mod tests {
                 dropped += b.hits.len() - a.hits.len();
             }
             // Whole looks are skipped too, without reading their rays.
-            for sr in rays.iter().filter(|sr| sr.looks.is_some()) {
-                let table = sr.looks.as_ref().expect("indexed");
+            for (sr, table) in rays.iter().filter_map(|sr| Some((sr, sr.looks.as_ref()?))) {
                 for class in s.classes_of(sr.source_index) {
                     for (step, looks) in observed.iter().enumerate() {
                         let shift = class.speed * step as f64;
