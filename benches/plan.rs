@@ -83,7 +83,7 @@ fn plan(c: &mut Criterion) {
                     Coordination::Priority => {
                         priority_total.insert(format!("{estimator:?}"), resp.expected_detections);
                     }
-                    Coordination::Iterated => {
+                    Coordination::Iterated | Coordination::Joint => {
                         let p = priority_total[&format!("{estimator:?}")];
                         assert!(resp.expected_detections >= p - 1e-9 * p.abs().max(1.0));
                     }

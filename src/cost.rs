@@ -132,7 +132,14 @@ pub fn precompute_ms(s: &Scenario) -> f64 {
 /// ([`Planner::plan`]), milliseconds on one core: positive and finite;
 /// O(sensors² + targets + history) to compute (microseconds).
 pub fn plan_ms(planner: &Planner, input: &PlanInput) -> f64 {
-    dot(&PLAN_MODEL, &plan_terms(planner, input)).max(FLOOR_MS)
+    let work = dot(&PLAN_MODEL, &plan_terms(planner, input)).max(FLOOR_MS);
+    // `joint` may use all of its budget on top of `iterated`'s work.
+    match (input.coordination, input.estimator) {
+        (Coordination::Joint, EstimatorKind::Exact) => {
+            work + input.joint.budget.as_secs_f64() * 1e3
+        }
+        _ => work,
+    }
 }
 
 /// The least either model predicts: every term can be 0 (sources that
@@ -345,10 +352,20 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> [f64; 18] {
         1.0 + (mean_near / 4.0).min(7.0)
     };
     // (runs, share of the nearby sensors excluded) per pass.
-    let passes: &[(f64, f64)] = match input.coordination {
-        Coordination::None => &[(1.0, 0.0)],
-        Coordination::Priority => &[(1.0, 0.0), (1.0, 0.5)],
-        Coordination::Iterated => &[(1.0, 0.0), (1.0, 0.5), (rounds, 1.0)],
+    // An exact plan's certificate takes one more search per sensor, with
+    // no exclusion; `joint` is `iterated`'s work (its budget is added in
+    // `plan_ms`).
+    let passes: &[(f64, f64)] = match (input.coordination, exact) {
+        (Coordination::None, false) => &[(1.0, 0.0)],
+        (Coordination::None, true) => &[(1.0, 0.0), (1.0, 0.0)],
+        (Coordination::Priority, false) => &[(1.0, 0.0), (1.0, 0.5)],
+        (Coordination::Priority, true) => &[(1.0, 0.0), (1.0, 0.5), (1.0, 0.0)],
+        (Coordination::Iterated | Coordination::Joint, false) => {
+            &[(1.0, 0.0), (1.0, 0.5), (rounds, 1.0)]
+        }
+        (Coordination::Iterated | Coordination::Joint, true) => {
+            &[(1.0, 0.0), (1.0, 0.5), (rounds, 1.0), (1.0, 0.0)]
+        }
     };
     let zone_area = s.width * s.height;
     let mean_half = me.iter().map(|m| m.1).sum::<f64>() * cs / n as f64;
@@ -373,11 +390,11 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> [f64; 18] {
         fov_rects += own;
         // (1 − a)^excluded per pass, the share of the targets no excluded
         // look holds (looks placed independently), kept as a product.
-        let mut base = [1.0; 3];
+        let mut base = [1.0; 4];
         for (b, &(_, share)) in base.iter_mut().zip(passes) {
             *b = (1.0 - a).max(0.0).powf(share);
         }
-        let mut miss = [1.0; 3];
+        let mut miss = [1.0; 4];
         let mut e = 0.0;
         for step in 1..=big_t {
             let fresh = near[i * stride + step];

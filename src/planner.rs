@@ -10,7 +10,8 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::cancel::{CancelToken, Cancelled, Progress};
-use crate::coordination::{Coordination, coordinate};
+use crate::coordination::joint::MAX_BUDGET_MS;
+use crate::coordination::{Bound, Coordination, Fleet, JointReport, JointSettings, coordinate};
 use crate::estimator::{
     ElementaryGrid, Estimator, ExactEstimator, PaperEstimator, SourceRays, Target,
 };
@@ -96,8 +97,19 @@ impl<'de> Deserialize<'de> for Id {
     }
 }
 
+impl std::fmt::Display for Id {
+    /// As in JSON: a string quoted, a number as given.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Id::Text(s) => write!(f, "{s:?}"),
+            Id::Number(n) => write!(f, "{n}"),
+        }
+    }
+}
+
 impl Id {
-    fn key(&self) -> String {
+    /// A key that tells ids apart: `"7"` and `7` are two ids.
+    pub(crate) fn key(&self) -> String {
         match self {
             Id::Text(s) => format!("s:{s}"),
             Id::Number(n) => format!("n:{n}"),
@@ -205,6 +217,17 @@ pub struct PlanRequest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(value_type = Option<u32>, minimum = 0, maximum = 16)]
     pub min_separation: Option<Integer>,
+    /// With `coordination: joint`: the certified gap at which it stops, in
+    /// `[0, 1]`; 0.001 by default. Other coordinations ignore it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(minimum = 0.0, maximum = 1.0)]
+    pub gap_target: Option<f64>,
+    /// With `coordination: joint`: the most time the plan may take,
+    /// milliseconds (1..=1000, 20 by default), counted from its start and
+    /// within the server's time limit. Other coordinations ignore it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<u32>, minimum = 1, maximum = 1000)]
+    pub budget_ms: Option<Integer>,
 }
 
 /// A lattice cell and its centre.
@@ -272,6 +295,16 @@ pub struct PlanResponse {
     pub expected_detections: f64,
     /// The same per step.
     pub expected_by_step: Vec<f64>,
+    /// With the `exact` estimator: an upper bound on what the best joint
+    /// plan could expect, and how far this plan may be from it (see the
+    /// README's "certified plan quality"). Absent for `paper`, whose total
+    /// is not a coverage.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bound: Option<Bound>,
+    /// With `coordination: joint` and the `exact` estimator: its rounds
+    /// after `iterated`, why it stopped and the time it used.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joint: Option<JointReport>,
     /// Planning time, microseconds.
     pub compute_micros: u64,
 }
@@ -279,7 +312,7 @@ pub struct PlanResponse {
 /// A validated plan request.
 #[derive(Debug, Clone)]
 pub struct PlanInput {
-    ids: Vec<Id>,
+    pub(crate) ids: Vec<Id>,
     pub(crate) starts: Vec<Cell>,
     pub(crate) types: Vec<usize>,
     pub(crate) targets: Vec<Target>,
@@ -291,6 +324,7 @@ pub struct PlanInput {
     pub(crate) observed: Observed,
     explain: bool,
     pub(crate) min_separation: usize,
+    pub(crate) joint: JointSettings,
 }
 
 fn finite(field: impl Fn() -> String, v: f64) -> Result<f64, ValidationError> {
@@ -302,6 +336,16 @@ fn finite(field: impl Fn() -> String, v: f64) -> Result<f64, ValidationError> {
 }
 
 impl PlanInput {
+    /// The sensors' cells now, in request order.
+    pub fn starts(&self) -> &[Cell] {
+        &self.starts
+    }
+
+    /// The sensors' types (indices into the scenario's), in request order.
+    pub fn types(&self) -> &[usize] {
+        &self.types
+    }
+
     /// Validates a request against a scenario.
     pub fn new(s: &Scenario, req: &PlanRequest) -> Result<Self, ValidationError> {
         if req.sensors.is_empty() {
@@ -424,6 +468,20 @@ impl PlanInput {
         let horizon = check_horizon("horizon", req.horizon.as_ref(), s.horizon)?;
         let min_separation = check_min_separation("min_separation", req.min_separation.as_ref())?
             .unwrap_or(s.min_separation);
+        let mut joint = JointSettings::default();
+        if let Some(g) = req.gap_target {
+            if !(0.0..=1.0).contains(&g) {
+                return Err(ValidationError::new(
+                    "gap_target",
+                    format!("must be a number in [0, 1], got {g}"),
+                ));
+            }
+            joint.gap_target = g;
+        }
+        if let Some(b) = &req.budget_ms {
+            let ms = b.check("budget_ms", 1..=MAX_BUDGET_MS as usize)?;
+            joint.budget = std::time::Duration::from_millis(ms as u64);
+        }
         Ok(PlanInput {
             min_separation,
             ids,
@@ -436,6 +494,7 @@ impl PlanInput {
             coordination: req.coordination.unwrap_or_default(),
             observed: req.observed.unwrap_or_default(),
             explain: req.explain.unwrap_or(false),
+            joint,
         })
     }
 }
@@ -581,44 +640,18 @@ impl Planner {
         cancel.check()?;
         let started = Instant::now();
         let s = &self.scenario;
-        let est: Box<dyn Estimator + '_> = match input.estimator {
-            EstimatorKind::Paper => Box::new(PaperEstimator::new(
-                s,
-                &self.stats,
-                &input.starts,
-                &input.types,
-                &input.targets,
-                input.horizon,
-            )),
-            EstimatorKind::Exact => {
-                let observed = self.observed_looks(input);
-                let est = ExactEstimator::new(
-                    s,
-                    &self.stats,
-                    &self.rays,
-                    self.grid.as_ref(),
-                    &observed,
-                    &input.targets,
-                    &input.starts,
-                    &input.types,
-                    input.horizon,
-                );
-                cancel.check()?;
-                est.prepare();
-                Box::new(est)
-            }
-        };
+        let est = self.estimator(input, cancel)?;
         cancel.check()?;
-        let result = coordinate(
+        let fleet = Fleet::new(
             s,
             est.as_ref(),
             &input.starts,
             &input.types,
             input.horizon,
-            input.coordination,
             input.min_separation,
             cancel,
-        )?;
+        );
+        let result = coordinate(&fleet, input.coordination, input.joint, started)?;
         let cell_out = |c: Cell| {
             let p = s.centre(c);
             CellOut {
@@ -658,7 +691,49 @@ impl Planner {
             plans,
             expected_detections: result.by_step.iter().sum(),
             expected_by_step: result.by_step,
+            bound: result.bound,
+            joint: result.joint,
             compute_micros: started.elapsed().as_micros() as u64,
+        })
+    }
+
+    /// The estimator `input` asks for, prepared for its sensors, targets
+    /// and looks.
+    ///
+    /// # Errors
+    /// [`Cancelled`] once `cancel` is cancelled.
+    pub(crate) fn estimator(
+        &self,
+        input: &PlanInput,
+        cancel: &CancelToken,
+    ) -> Result<Box<dyn Estimator + '_>, Cancelled> {
+        let s = &self.scenario;
+        Ok(match input.estimator {
+            EstimatorKind::Paper => Box::new(PaperEstimator::new(
+                s,
+                &self.stats,
+                &input.starts,
+                &input.types,
+                &input.targets,
+                input.horizon,
+            )),
+            EstimatorKind::Exact => {
+                let observed = self.observed_looks(input);
+                let est = ExactEstimator::new(
+                    s,
+                    &self.stats,
+                    &self.rays,
+                    self.grid.as_ref(),
+                    &observed,
+                    &input.targets,
+                    &input.starts,
+                    &input.types,
+                    input.horizon,
+                );
+                cancel.check()?;
+                est.prepare();
+                Box::new(est)
+            }
         })
     }
 

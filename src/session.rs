@@ -135,6 +135,16 @@ pub struct StepRequest {
     /// Include the search values in the response.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub explain: Option<bool>,
+    /// With `coordination: joint`: the certified gap at which it stops, in
+    /// `[0, 1]`; 0.001 by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(minimum = 0.0, maximum = 1.0)]
+    pub gap_target: Option<f64>,
+    /// With `coordination: joint`: the most time the step's plan may take,
+    /// milliseconds (1..=1000, 20 by default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<u32>, minimum = 1, maximum = 1000)]
+    pub budget_ms: Option<Integer>,
 }
 
 impl StepRequest {
@@ -355,6 +365,8 @@ impl Session {
                 .min_separation
                 .clone()
                 .or_else(|| self.settings.min_separation.clone()),
+            gap_target: step.gap_target,
+            budget_ms: step.budget_ms.clone(),
         };
         PreparedStep { request, tracks }
     }

@@ -8,7 +8,8 @@
 //! outside any pool (a one-core server plans on its async worker), and the
 //! ids of stored specs are unchanged.
 //! Fields added since (the minimum separation, 0 for the built-ins, and
-//! its violation counts) must be 0, and are left out of the digest.
+//! its violation counts) must be 0, and are left out of the digest, as is
+//! the certificate of exact plans (which must bound their value).
 #![allow(clippy::unwrap_used, missing_docs)]
 
 use serde_json::{Value, json};
@@ -22,10 +23,26 @@ fn digest(v: &Value) -> String {
     d.iter().map(|b| format!("{b:02x}")).collect()
 }
 
-/// Checks that a response kept no separation rule and removes the fields
-/// that say so, which the recorded responses predate.
-fn strip_separation(resp: &mut Value) {
+/// Checks that a response kept no separation rule and that an exact plan's
+/// certificate bounds its value, and removes the fields that say so, which
+/// the recorded responses predate.
+fn strip_added(resp: &mut Value) {
     let obj = resp.as_object_mut().unwrap();
+    let bound = obj.remove("bound");
+    if obj["estimator"] == "exact" {
+        let bound = bound.expect("an exact plan carries its bound");
+        let (upper, gap) = (
+            bound["upper"].as_f64().unwrap(),
+            bound["gap"].as_f64().unwrap(),
+        );
+        let value = obj["expected_detections"].as_f64().unwrap();
+        assert!(
+            upper >= value && (0.0..1.0).contains(&gap),
+            "{bound} for {value}"
+        );
+    } else {
+        assert_eq!(bound, None, "a paper plan has no bound");
+    }
     assert_eq!(obj.remove("min_separation"), Some(json!(0)));
     assert_eq!(obj.remove("separation_violations"), Some(json!(0)));
     for plan in obj["plans"].as_array_mut().unwrap() {
@@ -104,7 +121,7 @@ fn check_builtins(threads: Option<usize>) {
             };
             let mut resp = serde_json::to_value(resp).unwrap();
             resp["compute_micros"] = json!(0);
-            strip_separation(&mut resp);
+            strip_added(&mut resp);
             assert_eq!(
                 digest(&resp),
                 case["response_sha256"],

@@ -42,6 +42,41 @@ impl Target {
     }
 }
 
+/// What the exact objective counts at one step, as weights on disjoint
+/// pieces that every field of view of a sensor either holds whole or not
+/// at all: the elementary rectangles (see [`ElementaryGrid`]) of a block
+/// that holds every field of view the sensors can reach, each with its
+/// expected unseen targets, and the known targets, one each. A sensor of
+/// type `ty` at cell `k` expects `p_detect` times the weight of the pieces
+/// in [`Elements::block`] and of the known targets `F_k` holds.
+#[derive(Debug, Clone)]
+pub struct Elements<'a> {
+    grid: &'a ElementaryGrid,
+    /// First column of rectangles of the block.
+    pub a0: usize,
+    /// First row of rectangles of the block.
+    pub b0: usize,
+    /// Columns of the block.
+    pub na: usize,
+    /// Rows of the block.
+    pub nb: usize,
+    /// Per rectangle of the block, row-major: its expected unseen targets
+    /// (0 where no reachable field of view lies).
+    pub mass: Vec<f64>,
+    /// The known targets in the zone at the step.
+    pub known: Vec<Point>,
+}
+
+impl Elements<'_> {
+    /// The rectangles `[a0, a1) × [b0, b1)` (relative to the block) that
+    /// make up the field of view `fov_slot` (a scenario's `fovs` index) at
+    /// `k`, for a cell some sensor can reach.
+    pub fn block(&self, fov_slot: usize, k: Cell) -> (usize, usize, usize, usize) {
+        let (a0, a1, b0, b1) = self.grid.span(fov_slot, k);
+        (a0 - self.a0, a1 - self.a0, b0 - self.b0, b1 - self.b0)
+    }
+}
+
 /// A source of expected detections for the search.
 pub trait Estimator: Sync {
     /// The scenario estimated.
@@ -66,6 +101,13 @@ pub trait Estimator: Sync {
                 .on_lattice(k)
                 .then(|| self.value(sensor, k, t, excluded))
         });
+    }
+
+    /// The pieces the objective counts at step `t` (see [`Elements`]),
+    /// when the estimator can list them (the exact estimator with square
+    /// fields of view); `None` otherwise.
+    fn elements(&self, _t: usize) -> Option<Elements<'_>> {
+        None
     }
 
     /// True when the total over several sensors does not depend on the order

@@ -17,11 +17,17 @@ use seen::RayHits;
 use windows::{StepWindows, Window};
 
 use super::elementary::ElementaryGrid;
-use super::{Estimator, Target};
+use super::{Elements, Estimator, Target};
 use crate::geometry::{Point, Region, detection_within, union_within};
 use crate::scenario::{Cell, Look, Scenario};
 use crate::search::ValueGrid;
 use crate::stats::Stats;
+
+/// The most rectangles [`Estimator::elements`] lists at one step: a fleet
+/// spread over a larger block of a large grid gets no relaxation (its
+/// certificate falls back to the marginal bound), so the memory and the
+/// time of one step of it stay small.
+const MAX_ELEMENTS: usize = 1 << 18;
 
 /// The exact conditional expectation of the count in `F_k` at step `t`:
 /// the reported targets whose straight-line position is in `F_k`, plus
@@ -481,6 +487,46 @@ impl Estimator for ExactEstimator<'_> {
             }
             Some(ty.p_detect * (known + unseen))
         });
+    }
+
+    fn elements(&self, t: usize) -> Option<Elements<'_>> {
+        let grid = self.grid?;
+        let step = self.windows.get(t.checked_sub(1)?)?;
+        let (mut a0, mut a1, mut b0, mut b1) = (usize::MAX, 0, usize::MAX, 0);
+        for &(x0, x1, y0, y1) in &step.blocks {
+            (a0, a1, b0, b1) = (a0.min(x0), a1.max(x1), b0.min(y0), b1.max(y1));
+        }
+        let (na, nb) = (a1.checked_sub(a0)?, b1.checked_sub(b0)?);
+        if na == 0 || nb == 0 || na * nb > MAX_ELEMENTS {
+            return None;
+        }
+        let mut mass = vec![0.0; na * nb];
+        // Each window once: sensors may share one (a whole grid's).
+        let mut slots: Vec<usize> = step.slot.clone();
+        slots.sort_unstable();
+        slots.dedup();
+        for slot in slots {
+            let sensor = step.slot.iter().position(|&s| s == slot)?;
+            let (_, win) = self.window_of(sensor, t)?;
+            for b in 0..win.nb {
+                let row = (win.b0 + b - b0) * na + win.a0 - a0;
+                mass[row..row + win.na].copy_from_slice(win.row(b));
+            }
+        }
+        Some(Elements {
+            grid,
+            a0,
+            b0,
+            na,
+            nb,
+            mass,
+            known: self
+                .known
+                .iter()
+                .map(|tg| tg.at(t))
+                .filter(|&p| self.scenario.in_zone(p))
+                .collect(),
+        })
     }
 
     fn order_independent(&self) -> bool {

@@ -116,6 +116,13 @@ pub(super) struct Window {
     unseen: Vec<f64>,
 }
 
+impl Window {
+    /// The unseen mass of the window's row `b` (relative to its first).
+    pub(super) fn row(&self, b: usize) -> &[f64] {
+        &self.unseen[b * self.na..(b + 1) * self.na]
+    }
+}
+
 impl ExactEstimator<'_> {
     /// The unseen mass at step `t` of the elementary rectangles of a block.
     pub(super) fn window(

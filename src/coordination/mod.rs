@@ -1,0 +1,289 @@
+//! Coordination of several sensors' searches (the paper's steps 5–7, and ours).
+//!
+//! - [`Coordination::None`]: each sensor searches alone.
+//! - [`Coordination::Priority`]: each sensor searches alone; sensors are
+//!   ranked by the value of their path, highest first (ties: request order);
+//!   each next sensor searches again with its values reduced for the fields
+//!   of view of all higher-ranked sensors at the same step.
+//! - [`Coordination::Iterated`]: starts from `Priority`, then in rounds every
+//!   sensor, in rank order, searches again against all the others' current
+//!   paths, taking the new path only if it raises the total; it stops when a
+//!   round changes nothing, or after 10 rounds.
+//! - [`Coordination::Joint`]: starts from `Iterated`, then alternately
+//!   tightens the certificate and restarts best-response rounds from other
+//!   joint plans, keeping a better one, until the certified gap reaches a
+//!   target or a time budget runs out ([`joint`]). With the paper
+//!   estimator, which has no certificate, it is `Iterated`.
+//!
+//! Every plan with an order-independent (exact) estimator carries its
+//! certificate: an upper bound on the best joint plan ([`certificate`]).
+//!
+//! The total is `Σ_t Σ_p value(p, cell_p(t), t, looks of the sensors ranked
+//! above p at t)`: for the exact estimator the expected number of
+//! (target, step) pairs detected by at least one sensor, whatever the order
+//! (with detection probabilities, `Σ 1 − Π (1 − p)` over the sensors whose
+//! field of view holds the target). In `Iterated` a sensor's value for a
+//! cell is the change in that total when it stands there (its marginal
+//! against all the others for the exact estimator; for the paper estimator
+//! also the change in the lower-ranked sensors' overlap reductions), so each
+//! accepted change raises the total and it never ends below `Priority`.
+//!
+//! With a minimum separation `d > 0` ([`crate::separation`]) every mode
+//! keeps the sensors apart: paths are fixed in rank order, and each sensor
+//! after the first searches with the fixed paths' cells marked as
+//! violations, minimising (violations, −value) lexicographically. `None`
+//! still ignores the others' values, but not their positions.
+//!
+//! That pass never revisits a higher-ranked sensor, which may corner a
+//! lower one (push it against the zone's edge, say) although it could
+//! have stood back. So while some pair is too close, a repair round (at
+//! most [`MAX_REPAIRS`]) takes the highest-ranked sensor in a violation
+//! whose search around *every* other path has fewer violations than its
+//! own, gives it that path, lets the ranks below it plan again in order,
+//! and keeps the result if fewer pairs are too close in all. The last
+//! sensor still plans last, around the others' final paths.
+//!
+//! In `Iterated` a sensor's search counts violations against every other
+//! sensor's current path, and a new path is taken when it has fewer
+//! violations, or as many and more value, so each change lowers the
+//! number of pairs too close or keeps it and raises the total.
+
+pub mod certificate;
+mod fleet;
+pub mod joint;
+mod rounds;
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use utoipa::ToSchema;
+
+use crate::cancel::Cancelled;
+use crate::scenario::Cell;
+use crate::search::ValueGrid;
+use crate::separation::{self, Violations, mark_too_close};
+
+pub use certificate::Bound;
+use certificate::Certifier;
+pub use fleet::{Fleet, SensorPlan, path_moves, sensor_motion};
+use fleet::{path_slices, search};
+pub use joint::{JointReport, JointSettings};
+
+/// How sensors' searches are coordinated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum Coordination {
+    /// Every sensor plans alone (the paper's 'b' rows).
+    None,
+    /// The paper's priority scheme (the 'a' rows).
+    #[default]
+    Priority,
+    /// Priority, then best-response rounds against all others.
+    Iterated,
+    /// Iterated, then restarts until the certified gap reaches its target
+    /// or the time budget runs out.
+    Joint,
+}
+
+/// Largest number of best-response rounds in `Iterated`.
+pub const MAX_ROUNDS: usize = 10;
+
+/// Largest number of repair rounds of the separation.
+pub const MAX_REPAIRS: usize = 8;
+
+/// Plans of every sensor, in request order, with their ranks.
+#[derive(Debug, Clone)]
+pub struct Coordinated {
+    /// Per sensor, in request order.
+    pub plans: Vec<SensorPlan>,
+    /// Sensor indices from highest to lowest priority.
+    pub order: Vec<usize>,
+    /// Estimated distinct detections at steps 1..=T.
+    pub by_step: Vec<f64>,
+    /// Best-response rounds run (iterated only).
+    pub rounds: usize,
+    /// Repair rounds of the separation run (see the module docs).
+    pub repairs: usize,
+    /// Breaches of the minimum separation among the final paths.
+    pub violations: Violations,
+    /// The plan's certificate, for an order-independent (exact) estimator.
+    pub bound: Option<Bound>,
+    /// What `Joint` did after `Iterated` (with a certificate).
+    pub joint: Option<JointReport>,
+}
+
+/// Plans the fleet's sensors over its horizon; each moves at its type's
+/// speed through the scenario's free cells, and keeps the fleet's minimum
+/// separation from the others wherever it can (see the module docs). With
+/// an order-independent (exact) estimator the plan carries its
+/// [certificate](certificate).
+///
+/// # Errors
+/// [`Cancelled`] once the fleet's token is cancelled: it is checked before
+/// every step's values of every search and between sensors and rounds, so
+/// the work stops within one sensor-step's fill.
+pub fn coordinate(
+    fleet: &Fleet,
+    mode: Coordination,
+    joint: JointSettings,
+    started: Instant,
+) -> Result<Coordinated, Cancelled> {
+    let Fleet {
+        est,
+        starts,
+        min_separation: d,
+        cancel,
+        ..
+    } = *fleet;
+    let n = starts.len();
+    let plan_one = |i: usize, fill: &mut dyn FnMut(usize, &mut ValueGrid), avoid: Vec<&[Cell]>| {
+        fleet.plan_one(i, fill, avoid)
+    };
+    // The paths of `sensors`, when there is a separation to keep.
+    let paths =
+        |plans: &[SensorPlan], sensors: &mut dyn Iterator<Item = usize>| -> Vec<Vec<Cell>> {
+            if d == 0 {
+                return Vec::new();
+            }
+            sensors.map(|q| plans[q].path.clone()).collect()
+        };
+    // Every sensor alone.
+    let mut plans: Vec<SensorPlan> = (0..n)
+        .into_par_iter()
+        .with_min_len(crate::parallel::min_len())
+        .map(|i| plan_one(i, &mut |t, g| est.fill(i, starts[i], t, &[], g), Vec::new()))
+        .collect();
+    cancel.check()?;
+    let solo: Vec<(f64, Vec<Cell>)> = plans.iter().map(|p| (p.value, p.path.clone())).collect();
+    let mut order: Vec<usize> = (0..n).collect();
+    // Stable sort: ties keep request order.
+    order.sort_by(|&a, &b| plans[b].value.total_cmp(&plans[a].value));
+    // Each sensor's lone values: without coordination but apart it keeps
+    // them, and at a step where no higher-ranked look comes near its reach
+    // its values against them are these (the same fill, of no looks).
+    // An exact plan's certificate starts from them too.
+    let alone: Vec<ValueGrid> = if mode != Coordination::None || d > 0 || est.order_independent() {
+        plans.iter().map(|p| p.grid.clone()).collect()
+    } else {
+        Vec::new()
+    };
+    // The priority pass's search of the sensor ranked `rank`: its values
+    // against the sensors ranked above it (its lone values without
+    // coordination), around the paths of those sensors, or of every other
+    // sensor when `around_all`.
+    let ranked = |plans: &[SensorPlan], rank: usize, around_all: bool| -> SensorPlan {
+        let i = order[rank];
+        let above = &order[..rank];
+        let avoid = if around_all {
+            paths(plans, &mut (0..n).filter(|&j| j != i))
+        } else {
+            paths(plans, &mut above.iter().copied())
+        };
+        let avoid = avoid.iter().map(Vec::as_slice).collect();
+        if mode == Coordination::None {
+            let mut grid = alone[i].clone();
+            mark_too_close(&mut grid, starts[i], d, avoid);
+            search(grid, starts[i])
+        } else {
+            let looks = fleet.looks_by_step(&path_slices(plans), above, i);
+            plan_one(
+                i,
+                &mut |t, g| match &looks[t - 1][..] {
+                    [] => g.copy_step(t, &alone[i]),
+                    near => est.fill(i, starts[i], t, near, g),
+                },
+                avoid,
+            )
+        }
+    };
+    let mut rounds = 0;
+    let mut repairs = 0;
+    if mode != Coordination::None || d > 0 {
+        // Priority: each sensor against the ones above it, in rank order.
+        for rank in 1..n {
+            plans[order[rank]] = ranked(&plans, rank, false);
+            cancel.check()?;
+        }
+    }
+    if d > 0 {
+        // Repair: a higher-ranked sensor may have cornered a lower one,
+        // which the pass above never revisits. The highest-ranked sensor
+        // too close to another that can have fewer violations against every
+        // other path takes that path, the ranks below it plan again in
+        // order, and the change stays if fewer pairs are too close.
+        let mut total = separation::count(&all_paths(&plans), d);
+        while total.pairs > 0 && repairs < MAX_REPAIRS {
+            repairs += 1;
+            let mut improved = false;
+            for rank in 0..n {
+                let i = order[rank];
+                if total.per_sensor[i] == 0 {
+                    continue;
+                }
+                let candidate = ranked(&plans, rank, true);
+                cancel.check()?;
+                if candidate.violations >= total.per_sensor[i] {
+                    continue;
+                }
+                let mut trial = plans.clone();
+                trial[i] = candidate;
+                for below in rank + 1..n {
+                    trial[order[below]] = ranked(&trial, below, false);
+                    cancel.check()?;
+                }
+                let after = separation::count(&all_paths(&trial), d);
+                if after.pairs < total.pairs {
+                    (plans, total) = (trial, after);
+                    improved = true;
+                    break;
+                }
+            }
+            if !improved {
+                break;
+            }
+        }
+    }
+    if matches!(mode, Coordination::Iterated | Coordination::Joint) {
+        rounds = rounds::best_responses(fleet, &mut plans, &order, MAX_ROUNDS, None)?.rounds;
+    }
+    let mut by_step = fleet.by_step(&path_slices(&plans), &order);
+    cancel.check()?;
+    let mut report = None;
+    let bound = if est.order_independent() {
+        let mut value: f64 = by_step.iter().sum();
+        let mut certifier = Certifier::new(fleet, solo, &alone);
+        if mode == Coordination::Joint {
+            report = Some(joint::improve(
+                fleet,
+                &mut plans,
+                &order,
+                &mut certifier,
+                joint,
+                started,
+            )?);
+            by_step = fleet.by_step(&path_slices(&plans), &order);
+            value = by_step.iter().sum();
+        } else {
+            certifier.tighten(&path_slices(&plans), value)?;
+        }
+        Some(Bound::new(value, [certifier.upper()]))
+    } else {
+        None
+    };
+    let violations = separation::count(&all_paths(&plans), d);
+    Ok(Coordinated {
+        plans,
+        order,
+        by_step,
+        rounds,
+        repairs,
+        violations,
+        bound,
+        joint: report,
+    })
+}
+
+fn all_paths(plans: &[SensorPlan]) -> Vec<Vec<Cell>> {
+    plans.iter().map(|p| p.path.clone()).collect()
+}

@@ -1,0 +1,113 @@
+//! Best-response rounds: every sensor in rank order searches again against
+//! all the others' current paths, and takes the new path when it has fewer
+//! separation violations, or as many and more value (see the module docs
+//! of [`crate::coordination`]).
+
+use std::time::Instant;
+
+use super::fleet::{Fleet, SensorPlan, path_moves, path_slices};
+use crate::cancel::Cancelled;
+use crate::scenario::Cell;
+
+/// What [`best_responses`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Rounds {
+    /// Rounds run.
+    pub rounds: usize,
+    /// Whether the last round changed nothing (a best-response
+    /// equilibrium), rather than the rounds or the time running out.
+    pub settled: bool,
+}
+
+/// Runs rounds over `plans` (request order) with sensors in `order` until
+/// one changes nothing, `max_rounds` have run, or `deadline` (checked
+/// between sensors) has passed. A sensor's value for a cell is the change
+/// in the total when it stands there: its marginal against all the others
+/// for an order-independent estimator, and for the paper estimator also
+/// the change in the lower-ranked sensors' overlap reductions. So each
+/// accepted change raises the total (or lowers the violations).
+///
+/// # Errors
+/// [`Cancelled`] once the fleet's token is cancelled.
+pub fn best_responses(
+    fleet: &Fleet,
+    plans: &mut [SensorPlan],
+    order: &[usize],
+    max_rounds: usize,
+    deadline: Option<Instant>,
+) -> Result<Rounds, Cancelled> {
+    let (est, starts, d) = (fleet.est, fleet.starts, fleet.min_separation);
+    let n = plans.len();
+    let mut rounds = 0;
+    let mut changed = true;
+    while changed && rounds < max_rounds {
+        changed = false;
+        rounds += 1;
+        for rank in 0..order.len() {
+            if deadline.is_some_and(|d| Instant::now() >= d) {
+                return Ok(Rounds {
+                    rounds,
+                    settled: false,
+                });
+            }
+            let i = order[rank];
+            let avoid: Vec<&[Cell]> = if d == 0 {
+                Vec::new()
+            } else {
+                (0..n)
+                    .filter(|&j| j != i)
+                    .map(|j| plans[j].path.as_slice())
+                    .collect()
+            };
+            let grid_plan = if est.order_independent() {
+                let others: Vec<usize> = order.iter().copied().filter(|&j| j != i).collect();
+                let looks = fleet.looks_by_step(&path_slices(plans), &others, i);
+                fleet.plan_one(
+                    i,
+                    &mut |t, g| est.fill(i, starts[i], t, &looks[t - 1], g),
+                    avoid,
+                )
+            } else {
+                let current = path_slices(plans);
+                fleet.plan_one(
+                    i,
+                    &mut |t, g| {
+                        g.fill_step(t, |dc, dr| {
+                            let k = Cell {
+                                col: starts[i].col + dc,
+                                row: starts[i].row + dr,
+                            };
+                            Some(fleet.rank_change(&current, order, rank, k, t))
+                        });
+                    },
+                    avoid,
+                )
+            };
+            fleet.cancel.check()?;
+            let current = path_moves(starts[i], &plans[i].path);
+            let (current_value, current_violations) = grid_plan
+                .grid
+                .path_score(&current)
+                .unwrap_or((f64::NEG_INFINITY, u32::MAX));
+            let tol = 1e-9 * current_value.abs().max(1.0);
+            if grid_plan.violations < current_violations
+                || (grid_plan.violations == current_violations
+                    && grid_plan.value > current_value + tol)
+            {
+                plans[i] = grid_plan;
+                changed = true;
+            } else {
+                plans[i] = SensorPlan {
+                    value: current_value,
+                    violations: current_violations,
+                    path: std::mem::take(&mut plans[i].path),
+                    grid: grid_plan.grid,
+                };
+            }
+        }
+    }
+    Ok(Rounds {
+        rounds,
+        settled: !changed,
+    })
+}
