@@ -25,6 +25,7 @@ pub mod cancel;
 pub mod coordination;
 pub mod cost;
 pub mod estimator;
+pub mod evaluate;
 pub mod geometry;
 pub mod http;
 mod parallel;

@@ -579,6 +579,20 @@ impl ValueGrid {
         self.path_score(moves).map(|(_, violations)| violations)
     }
 
+    /// The first step (0-based) of `moves` that is not a legal step from
+    /// where the path then is (see the module docs), or `None` when every
+    /// step is legal. Values play no part.
+    pub fn first_illegal_step(&self, moves: &[(i32, i32)]) -> Option<usize> {
+        let mut o = self.motion.start();
+        for (t, &d) in moves.iter().enumerate() {
+            match self.motion.step(o, d) {
+                Some(next) if t < self.horizon() => o = next,
+                _ => return Some(t),
+            }
+        }
+        None
+    }
+
     /// [`ValueGrid::path_value`] and [`ValueGrid::path_violations`] in one
     /// walk along the path.
     pub fn path_score(&self, moves: &[(i32, i32)]) -> Option<(f64, u32)> {

@@ -90,6 +90,26 @@ UNSCHEMATISABLE = [
         "a bound on the inline scenario's predicted precompute time (src/cost.rs)",
     ),
     (
+        r"^paths\[\d+\]\.sensor: (no sensor .* in `sensors`|a second path for sensor)",
+        "a path names one of the sensors of another array, each once",
+    ),
+    (
+        r"^paths: sensor .* has no path: give one per sensor",
+        "one path for every item of another array (`sensors`)",
+    ),
+    (
+        r"^paths\[\d+\]\.path: must hold the cells of steps 1\.\.=\d+",
+        "a path's length is the horizon, given in another field or by the scenario",
+    ),
+    (
+        r"^paths\[\d+\]\.path\[\d+\]: \(col -?\d+, row -?\d+\) (is off the lattice|is in a no-go zone|cannot be reached)",
+        "a cell must lie on the lattice and outside the no-go zones of the scenario named by the path or body",
+    ),
+    (
+        r"^paths\[\d+\]\.path\[\d+\]: the move from .* is beyond the speed",
+        "a move is bounded by the previous cell (or the sensor's own) and its type's speed",
+    ),
+    (
         r"^detections: the session would follow \d+ targets",
         "a bound on the session's tracks: this step's detections plus those kept from earlier steps",
     ),

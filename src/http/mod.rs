@@ -16,6 +16,8 @@
 //! | GET | `/v1/scenarios/{id}/stats` | 200 per-cell statistics |
 //! | POST | `/v1/scenarios/{id}/plan` | 200 [`PlanResponse`](crate::planner::PlanResponse) |
 //! | POST | `/v1/plan` | 200 plan (scenario by id or inline) |
+//! | POST | `/v1/scenarios/{id}/evaluate` | 200 [`EvaluateResponse`](crate::evaluate::EvaluateResponse) |
+//! | POST | `/v1/evaluate` | 200 scores (scenario by id or inline) |
 //! | POST | `/v1/sessions` | 201 session |
 //! | GET | `/v1/sessions/{id}` | 200 session |
 //! | DELETE | `/v1/sessions/{id}` | 204 |
@@ -44,9 +46,20 @@ macro_rules! plan_rules {
     };
 }
 
+/// The rules of an evaluate request's paths that no JSON Schema can state.
+macro_rules! path_rules {
+    () => {
+        " The paths' rules (each a 422 whose `detail` names the field): one path per sensor, \
+        each naming a sensor of `sensors` once, of exactly T cells (the horizon's steps 1..T), \
+        every cell on the lattice and outside the no-go zones, each step a move of at most the \
+        sensor type's speed (king moves) that free cells allow, from the sensor's own cell."
+    };
+}
+
 pub mod cache;
 pub mod config;
 pub mod error;
+pub mod evaluate;
 pub mod extract;
 pub mod health;
 pub mod middleware;
@@ -302,6 +315,8 @@ pub fn router(state: AppState) -> Router {
         .route("/v1/scenarios/{id}/stats", get(scenarios::stats))
         .route("/v1/scenarios/{id}/plan", post(plan::plan))
         .route("/v1/plan", post(plan::plan_inline))
+        .route("/v1/scenarios/{id}/evaluate", post(evaluate::evaluate))
+        .route("/v1/evaluate", post(evaluate::evaluate_inline))
         .route("/v1/sessions", post(sessions::create))
         .route(
             "/v1/sessions/{id}",

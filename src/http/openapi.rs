@@ -17,8 +17,9 @@ use utoipa::{Modify, OpenApi, ToResponse, ToSchema};
 
 use super::error::{ApiError, Problem};
 use super::registry::JobStatus;
-use super::{health, middleware, plan, scenarios, sessions};
+use super::{evaluate, health, middleware, plan, scenarios, sessions};
 use crate::coordination::Coordination;
+use crate::evaluate::SensorPathIn;
 use crate::planner::{
     EstimatorKind, MAX_HISTORY_POSITIONS, Observed, PositionIn, SensorIn, TargetIn,
 };
@@ -61,6 +62,8 @@ Every error is an RFC 9457 problem (`application/problem+json`, schema \
         scenarios::stats,
         plan::plan,
         plan::plan_inline,
+        evaluate::evaluate,
+        evaluate::evaluate_inline,
         sessions::create,
         sessions::step,
         sessions::get,
@@ -77,6 +80,8 @@ Every error is an RFC 9457 problem (`application/problem+json`, schema \
             InvalidScenario,
             InvalidPlanRequest,
             InvalidInlinePlanRequest,
+            InvalidEvaluateRequest,
+            InvalidInlineEvaluateRequest,
             InvalidSession,
             SessionNotFound,
             Unauthorized,
@@ -201,13 +206,15 @@ pub async fn serve() -> impl IntoResponse {
 /// for the schema) with one more, required: the two shapes of the body of
 /// `POST /v1/plan`.
 macro_rules! plan_request_with {
-    ($(#[$doc:meta])* $name:ident, $(#[$field_doc:meta])* $field:ident: $ty:ty) => {
+    ($(#[$doc:meta])* $name:ident, $($(#[$field_doc:meta])* $field:ident: $ty:ty),+ $(,)?) => {
         $(#[$doc])*
         #[derive(Debug, ToSchema)]
         #[serde(deny_unknown_fields)]
         pub struct $name {
-            $(#[$field_doc])*
-            pub $field: $ty,
+            $(
+                $(#[$field_doc])*
+                pub $field: $ty,
+            )+
             /// Sensors now.
             #[schema(min_items = 1, max_items = 256)]
             pub sensors: Vec<SensorIn>,
@@ -236,6 +243,14 @@ macro_rules! plan_request_with {
             /// response counts.
             #[schema(value_type = Option<u32>, minimum = 0, maximum = 16)]
             pub min_separation: Option<Integer>,
+            /// With `coordination: joint`: the certified gap at which it
+            /// stops, in `[0, 1]`; 0.001 by default.
+            #[schema(minimum = 0.0, maximum = 1.0)]
+            pub gap_target: Option<f64>,
+            /// With `coordination: joint`: the most time the plan may
+            /// take, milliseconds (1..=1000, 20 by default).
+            #[schema(value_type = Option<u32>, minimum = 1, maximum = 1000)]
+            pub budget_ms: Option<Integer>,
         }
     };
 }
@@ -264,6 +279,49 @@ pub enum InlinePlanRequest {
     ById(PlanRequestById),
     /// The scenario inline.
     WithScenario(PlanRequestWithScenario),
+}
+
+plan_request_with!(
+    /// Body of `POST /v1/scenarios/{id}/evaluate`: a plan request's fields
+    /// (its `coordination`, `explain`, `gap_target` and `budget_ms` play no
+    /// part) and the paths to score.
+    EvaluateBody,
+    /// One path per sensor.
+    #[schema(min_items = 1, max_items = 256)]
+    paths: Vec<SensorPathIn>
+);
+
+plan_request_with!(
+    /// `POST /v1/evaluate` naming its scenario.
+    EvaluateRequestById,
+    /// Id of a registered scenario, or of one sent inline before.
+    #[schema(example = "paper-v10")]
+    scenario_id: String,
+    /// One path per sensor.
+    #[schema(min_items = 1, max_items = 256)]
+    paths: Vec<SensorPathIn>,
+);
+
+plan_request_with!(
+    /// `POST /v1/evaluate` carrying its scenario.
+    EvaluateRequestWithScenario,
+    /// The scenario itself; precomputed on first use and cached.
+    scenario: ScenarioSpec,
+    /// One path per sensor.
+    #[schema(min_items = 1, max_items = 256)]
+    paths: Vec<SensorPathIn>,
+);
+
+/// Body of `POST /v1/evaluate`: the body of `POST
+/// /v1/scenarios/{id}/evaluate` plus exactly one of `scenario_id` and
+/// `scenario`.
+#[derive(Debug, ToSchema)]
+#[serde(untagged)]
+pub enum InlineEvaluateRequest {
+    /// The scenario by id.
+    ById(EvaluateRequestById),
+    /// The scenario inline.
+    WithScenario(EvaluateRequestWithScenario),
 }
 
 macro_rules! session_request_with {
@@ -354,7 +412,14 @@ impl Modify for Closed {
                     .build(),
             )));
         }
-        for name in ["PlanRequest", "PlanRequestById", "PlanRequestWithScenario"] {
+        for name in [
+            "PlanRequest",
+            "PlanRequestById",
+            "PlanRequestWithScenario",
+            "EvaluateBody",
+            "EvaluateRequestById",
+            "EvaluateRequestWithScenario",
+        ] {
             let Some(RefOr::T(Schema::Object(object))) = components.schemas.get_mut(name) else {
                 continue;
             };
@@ -536,6 +601,49 @@ pub struct InvalidPlanRequest(pub Problem);
     )
 )]
 pub struct InvalidInlinePlanRequest(pub Problem);
+
+/// The request is well-formed but a value is outside its bounds or the
+/// scenario's zone, or a path is not one the sensor could take. `detail`
+/// starts with the JSON path of the offending field and a colon.
+#[derive(Debug, ToResponse)]
+#[response(
+    content_type = "application/problem+json",
+    examples(
+        ("speed" = (summary = "A move beyond the sensor's speed", value = json!(invalid(
+            "paths[0].path[1]",
+            "the move from (col 6, row 4) to (col 8, row 4) is beyond the speed of type \"default\" (1 cells a step)"
+        )))),
+        ("missing" = (summary = "A sensor without a path", value = json!(invalid(
+            "paths", "sensor \"c\" has no path: give one per sensor"
+        )))),
+        ("length" = (summary = "A path of the wrong length", value = json!(invalid(
+            "paths[1].path", "must hold the cells of steps 1..=3 (3 cells), got 2"
+        )))),
+        ("no-go" = (summary = "A cell in a no-go zone", value = json!(invalid(
+            "paths[0].path[2]", "(col 12, row 4) is in a no-go zone: no sensor may stand on it"
+        )))),
+    )
+)]
+pub struct InvalidEvaluateRequest(pub Problem);
+
+/// [`InvalidEvaluateRequest`]'s cases, and those of a scenario named or
+/// sent in the body as in `POST /v1/plan`.
+#[derive(Debug, ToResponse)]
+#[response(
+    content_type = "application/problem+json",
+    examples(
+        ("one-of" = (summary = "Neither scenario_id nor scenario", value = json!(problem(
+            ApiError::Unprocessable("exactly one of `scenario_id` and `scenario` is required".to_owned())
+        )))),
+        ("unknown-sensor" = (summary = "A path for a sensor not in `sensors`", value = json!(invalid(
+            "paths[2].sensor", "no sensor \"z\" in `sensors`"
+        )))),
+        ("off-lattice" = (summary = "A cell off the lattice", value = json!(invalid(
+            "paths[0].path[0]", "(col -1, row 4) is off the lattice of 30 columns and 30 rows"
+        )))),
+    )
+)]
+pub struct InvalidInlineEvaluateRequest(pub Problem);
 
 /// The server requires an API key and the request has none, or a wrong one.
 #[derive(Debug, ToResponse)]
@@ -835,7 +943,45 @@ pub mod examples {
             ],
             "expected_detections": 19.0996,
             "expected_by_step": [4.808, 6.538, 7.7535],
+            "bound": {"upper": 19.4305, "gap": 0.017},
             "compute_micros": 335
+        })
+    }
+
+    /// [`plan_request`]'s sensors and targets with the paths of
+    /// [`plan_response`], to score.
+    pub fn evaluate_request() -> Value {
+        let mut req = plan_request();
+        req["paths"] = json!([
+            {"sensor": "a", "path": [{"col": 6, "row": 4}, {"col": 7, "row": 3}, {"col": 8, "row": 2}]},
+            {"sensor": 7, "path": [{"col": 14, "row": 16}, {"col": 13, "row": 17}, {"col": 12, "row": 18}]},
+            {"sensor": "c", "path": [{"col": 23, "row": 5}, {"col": 22, "row": 4}, {"col": 22, "row": 3}]}
+        ]);
+        req
+    }
+
+    /// [`evaluate_request`] naming its scenario.
+    pub fn evaluate_request_by_id() -> Value {
+        let mut req = evaluate_request();
+        req["scenario_id"] = json!("paper-v10");
+        req
+    }
+
+    /// The scores of [`evaluate_request`]'s paths.
+    pub fn evaluate_response() -> Value {
+        json!({
+            "scenario": "paper-v10",
+            "horizon": 3,
+            "estimator": "exact",
+            "min_separation": 0,
+            "expected_detections": 19.0996,
+            "expected_by_step": [4.808, 6.538, 7.7535],
+            "separation_violations": 0,
+            "sensors": [
+                {"sensor": "a", "marginal": 6.9032, "separation_violations": 0},
+                {"sensor": 7, "marginal": 5.8559, "separation_violations": 0},
+                {"sensor": "c", "marginal": 6.3405, "separation_violations": 0}
+            ]
         })
     }
 

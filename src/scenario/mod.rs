@@ -238,6 +238,22 @@ impl Integer {
         (v.fract() == 0.0 && (0.0..18_446_744_073_709_551_616.0).contains(&v)).then_some(v as u64)
     }
 
+    /// The value, when it is a whole number that fits an `i64`.
+    pub fn signed(&self) -> Option<i64> {
+        if let Some(v) = self.0.as_i64() {
+            return Some(v);
+        }
+        let v = self.0.as_f64()?;
+        (v.fract() == 0.0
+            && (-9_223_372_036_854_775_808.0..9_223_372_036_854_775_808.0).contains(&v))
+        .then_some(v as i64)
+    }
+
+    /// The number as given.
+    pub fn raw(&self) -> &serde_json::Number {
+        &self.0
+    }
+
     /// The value if it lies in `range`, else a validation error for
     /// `field` that states the range.
     pub fn check(

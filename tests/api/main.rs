@@ -6,6 +6,7 @@
 mod bounded;
 mod connections;
 mod errors;
+mod evaluate;
 mod fleet;
 mod fuzz;
 mod helpers;

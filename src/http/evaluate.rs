@@ -1,0 +1,129 @@
+//! `POST /v1/scenarios/{id}/evaluate` and `POST /v1/evaluate`: scoring
+//! given paths (see [`crate::evaluate`]).
+
+use std::sync::Arc;
+
+use axum::Extension;
+use axum::extract::State;
+
+use super::AppState;
+use super::error::ApiError;
+use super::extract::{Json, Path, QueuedJson};
+use super::middleware::RequestStart;
+use super::openapi::{self as doc, examples};
+use super::plan::{CancelOnDrop, resolve_scenario};
+use crate::coordination::Coordination;
+use crate::cost;
+use crate::evaluate::{EvaluateInput, EvaluateRequest, EvaluateResponse};
+use crate::planner::Planner;
+
+/// Validates `req`, refuses it past the plan cost limit, and scores it on
+/// rayon, cancelled as soon as nobody waits for it.
+async fn evaluate_admitted(
+    state: &AppState,
+    start: Option<Extension<RequestStart>>,
+    planner: Arc<Planner>,
+    req: &EvaluateRequest,
+) -> Result<EvaluateResponse, ApiError> {
+    let input = EvaluateInput::new(&planner, req)?;
+    // Scoring is the estimator's preparation and one value per sensor and
+    // step: less than a plan without coordination, the bound used.
+    let mut uncoordinated = input.plan.clone();
+    uncoordinated.coordination = Coordination::None;
+    let predicted_ms = cost::plan_ms(&planner, &uncoordinated);
+    if let Some(limit_ms) = state.settings.max_plan_ms
+        && predicted_ms > limit_ms
+    {
+        metrics::counter!("vigil_plans_refused_total", "reason" => "cost").increment(1);
+        return Err(ApiError::PlanTooCostly {
+            predicted_ms,
+            limit_ms,
+        });
+    }
+    let guard = CancelOnDrop::new("evaluate", start, state);
+    let token = guard.token();
+    let res = super::on_rayon(move || planner.evaluate(&input, &token)).await;
+    guard.finish();
+    res?.map_err(|_| ApiError::Timeout)
+}
+
+/// `POST /v1/scenarios/{id}/evaluate`, body [`EvaluateRequest`] → 200
+/// [`EvaluateResponse`].
+#[utoipa::path(
+    post,
+    path = "/v1/scenarios/{id}/evaluate",
+    operation_id = "evaluateScenario",
+    tag = "planning",
+    summary = "Score given paths of the sensors",
+    description = concat!("Scores one path per sensor, whoever planned it: the expected number of \
+        distinct targets detected over steps 1..T (the total a plan reports as \
+        `expected_detections`, and per step), each sensor's marginal (what the total loses \
+        without its path) and the breaches of the minimum separation, with the requested \
+        estimator. The body is a plan request (its `coordination`, `explain`, `gap_target` and \
+        `budget_ms` play no part) plus `paths`. A plan's own paths score its \
+        `expected_detections`. With the `paper` estimator, whose total depends on the order, \
+        the paths count in the order given, the first as the highest priority.", plan_rules!(), path_rules!()),
+    params(("id" = String, Path, description = doc::SCENARIO_ID, example = "paper-v10")),
+    request_body(content = doc::EvaluateBody, description = "Sensors, targets, options and the paths.",
+        example = json!(examples::evaluate_request())),
+    responses(
+        (status = 200, description = "The paths' scores.", body = EvaluateResponse,
+            example = json!(examples::evaluate_response())),
+        (status = 400, response = doc::MalformedBody),
+        (status = 404, response = doc::ScenarioNotFound),
+        (status = 413, response = doc::PayloadTooLarge),
+        (status = 422, response = doc::InvalidEvaluateRequest),
+        (status = 503, response = doc::NotReady),
+    )
+)]
+pub async fn evaluate(
+    State(state): State<AppState>,
+    start: Option<Extension<RequestStart>>,
+    Path(id): Path<String>,
+    body: Result<QueuedJson<EvaluateRequest>, ApiError>,
+) -> Result<Json<EvaluateResponse>, ApiError> {
+    let planner = state.registry.resolve(&id).await?;
+    let QueuedJson(req) = body?;
+    Ok(Json(evaluate_admitted(&state, start, planner, &req).await?))
+}
+
+/// `POST /v1/evaluate`: the body of `/v1/scenarios/{id}/evaluate` plus
+/// either `"scenario_id"` or an inline `"scenario"`, as in `POST /v1/plan`.
+#[utoipa::path(
+    post,
+    path = "/v1/evaluate",
+    operation_id = "evaluate",
+    tag = "planning",
+    summary = "Score given paths in a scenario named or sent inline",
+    description = concat!("The same scoring as `POST /v1/scenarios/{id}/evaluate`, with the scenario \
+        in the body as in `POST /v1/plan`: exactly one of `scenario_id` and `scenario`.",
+        plan_rules!(), path_rules!(), spec_rules!()),
+    request_body(content = doc::InlineEvaluateRequest, description = "Scenario, sensors, targets, options and the paths.",
+        example = json!(examples::evaluate_request_by_id())),
+    responses(
+        (status = 200, description = "The paths' scores.", body = EvaluateResponse,
+            example = json!(examples::evaluate_response())),
+        (status = 400, response = doc::MalformedBody),
+        (status = 404, response = doc::ScenarioNotFound),
+        (status = 413, response = doc::PayloadTooLarge),
+        (status = 422, response = doc::InvalidInlineEvaluateRequest),
+        (status = 503, response = doc::NotReady),
+    )
+)]
+pub async fn evaluate_inline(
+    State(state): State<AppState>,
+    start: Option<Extension<RequestStart>>,
+    QueuedJson(body): QueuedJson<serde_json::Value>,
+) -> Result<Json<EvaluateResponse>, ApiError> {
+    let serde_json::Value::Object(mut fields) = body else {
+        return Err(ApiError::MalformedBody(
+            "the body must be a JSON object".into(),
+        ));
+    };
+    let scenario_id = fields.remove("scenario_id");
+    let inline = fields.remove("scenario");
+    let req: EvaluateRequest = serde_json::from_value(serde_json::Value::Object(fields))
+        .map_err(|e| ApiError::MalformedBody(e.to_string()))?;
+    let planner = resolve_scenario(&state, start, scenario_id, inline).await?;
+    Ok(Json(evaluate_admitted(&state, start, planner, &req).await?))
+}
