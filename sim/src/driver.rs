@@ -18,14 +18,54 @@
 use std::collections::{HashMap, HashSet, VecDeque};
 
 use rand::{SeedableRng, rngs::StdRng};
+use vigil::coordination::{Bound, Coordination};
 use vigil::geometry::Point;
-use vigil::planner::{Id, PlanRequest, PlanResponse, PositionIn, SensorIn, TargetIn};
+use vigil::planner::{
+    EstimatorKind, Id, PlanRequest, PlanResponse, PositionIn, SensorIn, TargetIn,
+};
 use vigil::scenario::{Cell, Scenario};
 use vigil::session::{SessionSettings, StepRequest};
 use vigil::world::World;
 
 use crate::metrics::StepCount;
 use crate::policy::{Policy, keep_apart, legal_moves, local_force_move, random_move};
+
+/// A plan's certificate, checked against the planner's contract: with the
+/// exact estimator a [`Bound`] no lower than the plan's own expected
+/// detections, with `gap = (upper − value) / upper` in `[0, 1]`; with the
+/// paper estimator, whose total is not a coverage, none. A joint plan with
+/// the exact estimator also says what its rounds did. Returns the bound.
+pub fn checked_bound(plan: &PlanResponse) -> Result<Option<Bound>, String> {
+    let exact = plan.estimator == EstimatorKind::Exact;
+    match plan.bound {
+        None if exact => Err("an exact plan without its certificate".into()),
+        Some(_) if !exact => Err("a paper plan with a certificate".into()),
+        None => Ok(None),
+        Some(b) => {
+            let value = plan.expected_detections;
+            // Rounding may not put the bound below the plan: the server
+            // raises it to the plan's value then.
+            if b.upper.is_nan() || b.upper < value {
+                return Err(format!("bound {} below the plan's {value}", b.upper));
+            }
+            let gap = if b.upper > 0.0 {
+                (b.upper - value) / b.upper
+            } else {
+                0.0
+            };
+            if !(0.0..=1.0).contains(&b.gap) || (b.gap - gap).abs() > 1e-9 {
+                return Err(format!(
+                    "gap {} for bound {} and value {value} (expected {gap})",
+                    b.gap, b.upper
+                ));
+            }
+            if plan.coordination == Coordination::Joint && plan.joint.is_none() {
+                return Err("a joint exact plan without its report".into());
+            }
+            Ok(Some(b))
+        }
+    }
+}
 
 /// Where the sensors start.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -390,6 +430,8 @@ impl Sim {
             // Only when set: requests otherwise stay as they were, and the
             // server applies the scenario's.
             min_separation: self.min_separation.map(Into::into),
+            gap_target: None,
+            budget_ms: None,
         }
     }
 

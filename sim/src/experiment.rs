@@ -10,7 +10,7 @@ use tokio::sync::Semaphore;
 use vigil::scenario::Scenario;
 
 use crate::client::{Client, ClientError};
-use crate::driver::{Sim, Start, fleet_types};
+use crate::driver::{Sim, Start, checked_bound, fleet_types};
 use crate::metrics::{Metrics, RunAccumulator, summarize};
 use crate::policy::{ALL_POLICIES, Policy};
 
@@ -153,6 +153,12 @@ pub async fn run_one(
                 }
             };
             acc.add_plan_time(ms);
+            if let Some(bound) = checked_bound(&resp).map_err(RunError::Contract)? {
+                acc.add_gap(bound.gap);
+            }
+            if let Some(joint) = &resp.joint {
+                acc.add_joint(joint);
+            }
             acc.add_plan_violations(
                 resp.separation_violations,
                 resp.plans.iter().map(|p| p.separation_violations),
@@ -313,8 +319,8 @@ pub fn experiment_fleet(name: &str, n: usize) -> Option<&'static str> {
 }
 
 /// The policies of an experiment, with their row letters: Table 1 compares
-/// the paper's method with (a) and without (b) coordination; Table 2 and
-/// `mixed` run every policy.
+/// the paper's method with (a) and without (b) coordination; Table 2,
+/// `mixed` and `fleet` run every policy of [`ALL_POLICIES`].
 pub fn experiment_policies(name: &str) -> Option<Vec<(char, Policy)>> {
     match name {
         "table1" => Some(vec![
@@ -323,5 +329,62 @@ pub fn experiment_policies(name: &str) -> Option<Vec<(char, Policy)>> {
         ]),
         "table2" | "mixed" | "fleet" => Some(('a'..).zip(ALL_POLICIES).collect()),
         _ => None,
+    }
+}
+
+/// The rows of an experiment that runs only the policies `chosen`, in the
+/// order given (repeats dropped), or all of its own when `chosen` is empty.
+/// A policy keeps its letter from the experiment's own list, so `1d` is
+/// `exact-iterated` in every Table 2; one outside it (`exact-joint`) takes
+/// the letters after that list's, in the order given.
+pub fn chosen_policies(name: &str, chosen: &[Policy]) -> Option<Vec<(char, Policy)>> {
+    let own = experiment_policies(name)?;
+    if chosen.is_empty() {
+        return Some(own);
+    }
+    let mut extra = ('a'..).skip(own.len());
+    let mut rows: Vec<(char, Policy)> = Vec::new();
+    for &policy in chosen {
+        if rows.iter().any(|&(_, p)| p == policy) {
+            continue;
+        }
+        let letter = match own.iter().find(|&&(_, p)| p == policy) {
+            Some(&(letter, _)) => letter,
+            None => extra.next()?,
+        };
+        rows.push((letter, policy));
+    }
+    Some(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chosen_policies_keep_their_letters() {
+        let all = chosen_policies("table2", &[]).expect("table2");
+        assert_eq!(all.len(), ALL_POLICIES.len());
+        assert!(!all.iter().any(|&(_, p)| p == Policy::ExactJoint));
+        let two = chosen_policies(
+            "table2",
+            &[
+                Policy::ExactJoint,
+                Policy::ExactIterated,
+                Policy::ExactJoint,
+            ],
+        );
+        assert_eq!(
+            two,
+            Some(vec![
+                ('i', Policy::ExactJoint),
+                ('d', Policy::ExactIterated)
+            ])
+        );
+        assert_eq!(
+            chosen_policies("table1", &[Policy::Paper, Policy::ExactJoint]),
+            Some(vec![('a', Policy::Paper), ('c', Policy::ExactJoint)])
+        );
+        assert_eq!(chosen_policies("table3", &[Policy::Paper]), None);
     }
 }

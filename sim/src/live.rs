@@ -9,8 +9,9 @@
 //!   heat map, the sources and their cones, the no-go zones) and then a
 //!   `frame` event for every state (sensors, their plans, traces and
 //!   fields of view, targets by status, running metrics and their series,
-//!   the planner's `explain` values). Every frame holds the whole state, so a
-//!   slow page skips frames without losing anything;
+//!   the plan's certified gap, the planner's `explain` values). Every frame
+//!   holds the whole state, so a slow page skips frames without losing
+//!   anything;
 //! - `GET /init` and `GET /frame`: the same as plain JSON;
 //! - `POST /control`: `{"action": "pause" | "resume" | "step"}` or
 //!   `{"action": "speed", "speed": steps_per_second}`.
@@ -40,12 +41,12 @@ use tokio::net::TcpListener;
 use tokio::sync::watch;
 use tokio::task::JoinHandle;
 use tokio::time::Instant;
-use vigil::planner::{Explain, PlanResponse};
+use vigil::planner::{EstimatorKind, Explain, PlanResponse};
 use vigil::scenario::{Cell, FovSpec};
 use vigil::stats::Stats;
 
 use crate::client::Client;
-use crate::driver::{Sim, TargetStatus};
+use crate::driver::{Sim, TargetStatus, checked_bound};
 use crate::experiment::{RunConfig, RunError};
 
 const PAGE: &str = include_str!("../static/live.html");
@@ -305,6 +306,9 @@ struct Init {
     scenario: String,
     name: Option<String>,
     policy: &'static str,
+    /// The policy's plans carry a certificate (the exact estimator), so
+    /// every frame after the first has a certified gap.
+    certified: bool,
     seed: u64,
     sensors: usize,
     steps: usize,
@@ -364,6 +368,11 @@ impl Init {
             scenario: opts.run.scenario_id.clone(),
             name: s.spec.name.clone(),
             policy: opts.run.policy.name(),
+            certified: opts
+                .run
+                .policy
+                .planner()
+                .is_some_and(|p| p.estimator == EstimatorKind::Exact),
             seed: opts.seed,
             sensors: opts.run.sensors,
             steps: opts.run.steps,
@@ -457,6 +466,12 @@ struct MetricsOut {
     violations: Option<u32>,
     /// The fraction of the run's plans with any (planner policies).
     violating_plans: Option<f64>,
+    /// The last plan's certified gap, `bound.gap` (exact estimator), and
+    /// its mean over the run's plans.
+    gap: Option<f64>,
+    gap_mean: Option<f64>,
+    /// The last plan's rounds after `iterated` (joint coordination).
+    joint_rounds: Option<usize>,
 }
 
 /// The metrics after every measured step, for the charts.
@@ -467,6 +482,7 @@ struct Series {
     once: Vec<f64>,
     calibration: Vec<Option<f64>>,
     plan_ms: Vec<Option<f64>>,
+    gap: Vec<Option<f64>>,
 }
 
 /// Running sums over the measured steps.
@@ -482,6 +498,8 @@ struct Running {
     plans: usize,
     cells: f64,
     plans_violating: usize,
+    gap: f64,
+    gaps: usize,
 }
 
 fn status_code(s: TargetStatus) -> u8 {
@@ -640,6 +658,8 @@ async fn drive(shared: Arc<Shared>, client: Client, opts: LiveOptions) -> Result
         let mut plan_ms = None;
         let mut predicted = None;
         let mut violations = None;
+        let mut gap = None;
+        let mut joint_rounds = None;
         let next = if cfg.policy.planner().is_some() {
             let mut req = sim.plan_request(cfg.policy, cfg.horizon);
             req.explain = Some(true);
@@ -648,6 +668,10 @@ async fn drive(shared: Arc<Shared>, client: Client, opts: LiveOptions) -> Result
             plan_ms = Some(ms);
             predicted = resp.expected_by_step.first().copied();
             violations = Some(resp.separation_violations);
+            gap = checked_bound(&resp)
+                .map_err(RunError::Contract)?
+                .map(|b| b.gap);
+            joint_rounds = resp.joint.map(|j| j.rounds);
             plan = Some(resp);
             next
         } else {
@@ -671,6 +695,10 @@ async fn drive(shared: Arc<Shared>, client: Client, opts: LiveOptions) -> Result
             run.plan_ms += ms;
             run.plans += 1;
         }
+        if let Some(g) = gap {
+            run.gap += g;
+            run.gaps += 1;
+        }
         let calibration = (run.predicted > 0.0).then(|| run.realized / run.predicted);
         let once = sim.detected_once();
         series.ad.push(count.detected as f64);
@@ -678,6 +706,7 @@ async fn drive(shared: Arc<Shared>, client: Client, opts: LiveOptions) -> Result
         series.once.push(once);
         series.calibration.push(calibration);
         series.plan_ms.push(plan_ms);
+        series.gap.push(gap);
         let metrics = MetricsOut {
             in_zone: count.in_zone,
             ad: count.detected,
@@ -696,6 +725,9 @@ async fn drive(shared: Arc<Shared>, client: Client, opts: LiveOptions) -> Result
             cells_mean: run.cells / run.steps as f64,
             violations,
             violating_plans: (run.plans > 0).then(|| run.plans_violating as f64 / run.plans as f64),
+            gap,
+            gap_mean: (run.gaps > 0).then(|| run.gap / run.gaps as f64),
+            joint_rounds,
         };
         publish(
             &shared,

@@ -4,6 +4,7 @@
 //! ```text
 //! vigil-sim --experiment table1 --seeds 10          # the paper's Table 1
 //! vigil-sim --experiment table2                     # every policy
+//! vigil-sim --experiment table2 --policy exact-iterated,exact-joint --seeds 10
 //! vigil-sim --experiment mixed                      # every policy on site-gates
 //! vigil-sim --experiment fleet                      # every policy on site-fleet, three fleets
 //! vigil-sim --scenario site-fleet --fleet drone:4,robot:6 --svg fleet.svg
@@ -22,8 +23,7 @@ use vigil::scenario::{Scenario, ScenarioSpec};
 use vigil_sim::client::{Client, spawn_local_server};
 use vigil_sim::driver::{Start, default_warmup, fleet_size, fleet_types};
 use vigil_sim::experiment::{
-    EXPERIMENTS, RunConfig, experiment_fleet, experiment_grid, experiment_policies, run_all,
-    run_one,
+    EXPERIMENTS, RunConfig, chosen_policies, experiment_fleet, experiment_grid, run_all, run_one,
 };
 use vigil_sim::live::{Live, LiveOptions};
 use vigil_sim::policy::Policy;
@@ -40,12 +40,18 @@ struct Args {
     /// `table2` (every policy) over NS ∈ {10, 6} × TV ∈ {10, 15}, or `mixed`
     /// (every policy on `site-gates` with NS ∈ {10, 6}), or `fleet` (every
     /// policy on `site-fleet` with ten robots, four drones and six robots,
-    /// ten drones).
+    /// ten drones). "Every policy" leaves out `exact-joint`; `--policy`
+    /// picks the rows' policies instead, e.g.
+    /// `--policy exact-iterated,exact-joint`.
     #[arg(long)]
     experiment: Option<String>,
-    /// Policy of a single run.
-    #[arg(long, value_enum, default_value_t = Policy::Exact)]
-    policy: Policy,
+    /// Policy of a single run (`exact` by default). With `--experiment`,
+    /// the experiment runs these policies instead of its own (each keeps
+    /// its row letter; `exact-joint`, in no experiment's own list, comes
+    /// after). Comma-separated or repeated; several without
+    /// `--experiment` run one row each.
+    #[arg(long, value_enum, value_delimiter = ',')]
+    policy: Vec<Policy>,
     /// Number of sensors of a single run.
     #[arg(long, default_value_t = 10)]
     sensors: usize,
@@ -187,7 +193,7 @@ async fn run(args: Args) -> Result<(), String> {
     let configs = match &args.experiment {
         Some(name) => {
             let unknown = || format!("unknown experiment `{name}` ({})", EXPERIMENTS.join(", "));
-            let policies = experiment_policies(name).ok_or_else(unknown)?;
+            let policies = chosen_policies(name, &args.policy).ok_or_else(unknown)?;
             let grid = experiment_grid(name).ok_or_else(unknown)?;
             let mut configs = Vec::new();
             for (n, (sensors, id)) in grid.iter().enumerate() {
@@ -212,14 +218,28 @@ async fn run(args: Args) -> Result<(), String> {
                     .ok_or_else(|| format!("--fleet {fleet:?}: expected NAME:COUNT,…"))?,
                 None => args.sensors,
             };
-            vec![config(
-                args.policy.name().to_owned(),
-                args.policy,
-                id,
-                scenario,
-                sensors,
-                args.fleet.as_deref(),
-            )]
+            let mut policies: Vec<Policy> = Vec::new();
+            for &policy in &args.policy {
+                if !policies.contains(&policy) {
+                    policies.push(policy);
+                }
+            }
+            if policies.is_empty() {
+                policies.push(Policy::Exact);
+            }
+            policies
+                .into_iter()
+                .map(|policy| {
+                    config(
+                        policy.name().to_owned(),
+                        policy,
+                        id.clone(),
+                        scenario.clone(),
+                        sensors,
+                        args.fleet.as_deref(),
+                    )
+                })
+                .collect()
         }
     };
     if configs.iter().any(|c| c.sensors == 0) {
@@ -228,6 +248,9 @@ async fn run(args: Args) -> Result<(), String> {
     for c in &configs {
         fleet_types(&c.scenario, c.fleet.as_deref(), c.sensors)
             .map_err(|e| format!("--fleet: {e}"))?;
+    }
+    if configs.len() > 1 && args.experiment.is_none() && (args.live || args.svg.is_some()) {
+        return Err("--live and --svg show a single run; give one --policy".into());
     }
     if args.live {
         if args.experiment.is_some() {

@@ -2,6 +2,8 @@
 //! intervals over seeds.
 
 use serde::Serialize;
+use vigil::coordination::JointReport;
+use vigil::coordination::joint::JointStop;
 
 /// What one step's counting found.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -41,6 +43,14 @@ pub struct RunAccumulator {
     /// Sensor plans in those responses, and those with a violation.
     sensor_plans: usize,
     sensor_plans_violating: usize,
+    /// Each plan's certified gap (exact estimator).
+    gaps: Vec<f64>,
+    /// Joint plans, their rounds, and those that stopped at the gap target
+    /// and on the time budget.
+    joint_plans: usize,
+    joint_rounds: usize,
+    joint_at_target: usize,
+    joint_out_of_budget: usize,
 }
 
 impl RunAccumulator {
@@ -79,6 +89,19 @@ impl RunAccumulator {
         self.realized_next += realized as f64;
     }
 
+    /// Adds a plan's certified gap (its `bound.gap`).
+    pub fn add_gap(&mut self, gap: f64) {
+        self.gaps.push(gap);
+    }
+
+    /// Adds what a joint plan's rounds did (its `joint`).
+    pub fn add_joint(&mut self, report: &JointReport) {
+        self.joint_plans += 1;
+        self.joint_rounds += report.rounds;
+        self.joint_at_target += usize::from(report.stopped == JointStop::Gap);
+        self.joint_out_of_budget += usize::from(report.stopped == JointStop::Budget);
+    }
+
     /// Adds a plan round trip.
     pub fn add_plan_time(&mut self, ms: f64) {
         self.plan_ms.push(ms);
@@ -89,10 +112,13 @@ impl RunAccumulator {
         let n = self.steps.max(1) as f64;
         let planner = !self.plan_ms.is_empty();
         self.plan_ms.sort_by(f64::total_cmp);
-        let pct = |p: f64| {
-            let v = &self.plan_ms;
-            v[((p * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1]
-        };
+        self.gaps.sort_by(f64::total_cmp);
+        // The nearest-rank percentile of sorted, non-empty samples.
+        let pct =
+            |v: &[f64], p: f64| v[((p * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1];
+        let gaps = !self.gaps.is_empty();
+        let joint = self.joint_plans > 0;
+        let per_joint = |n: usize| n as f64 / self.joint_plans as f64;
         Metrics {
             ad: self.ad / n,
             zd: self.zd / n,
@@ -109,13 +135,18 @@ impl RunAccumulator {
             detected_once,
             calibration: (planner && self.predicted_next > 0.0)
                 .then(|| self.realized_next / self.predicted_next),
-            plan_ms_p50: planner.then(|| pct(0.5)),
-            plan_ms_p99: planner.then(|| pct(0.99)),
+            plan_ms_p50: planner.then(|| pct(&self.plan_ms, 0.5)),
+            plan_ms_p99: planner.then(|| pct(&self.plan_ms, 0.99)),
             violating_plans: (self.plans > 0)
                 .then(|| self.plans_violating as f64 / self.plans as f64),
             violations_per_plan: (self.plans > 0).then(|| self.violation_pairs / self.plans as f64),
             violating_sensor_plans: (self.sensor_plans > 0)
                 .then(|| self.sensor_plans_violating as f64 / self.sensor_plans as f64),
+            gap_mean: gaps.then(|| self.gaps.iter().sum::<f64>() / self.gaps.len() as f64),
+            gap_p50: gaps.then(|| pct(&self.gaps, 0.5)),
+            joint_rounds: joint.then(|| per_joint(self.joint_rounds)),
+            joint_at_target: joint.then(|| per_joint(self.joint_at_target)),
+            joint_out_of_budget: joint.then(|| per_joint(self.joint_out_of_budget)),
         }
     }
 }
@@ -166,6 +197,25 @@ pub struct Metrics {
     /// step.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub violating_sensor_plans: Option<f64>,
+    /// Exact estimator: the mean over the run's plans of the certified gap,
+    /// `(upper − value) / upper`: how far below the best joint plan each
+    /// plan can be, at most, as a fraction of the bound.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gap_mean: Option<f64>,
+    /// Exact estimator: the median of the plans' certified gaps.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gap_p50: Option<f64>,
+    /// Joint coordination: the mean number of rounds after `iterated`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub joint_rounds: Option<f64>,
+    /// Joint coordination: the fraction of plans that reached the gap
+    /// target.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub joint_at_target: Option<f64>,
+    /// Joint coordination: the fraction of plans stopped by the time
+    /// budget (the rest settled: rounds in a row found nothing better).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub joint_out_of_budget: Option<f64>,
 }
 
 /// Two-sided 97.5% quantile of Student's t with `df` degrees of freedom.
@@ -227,6 +277,11 @@ pub fn summarize(runs: &[Metrics]) -> (Metrics, Metrics) {
     (mean.violations_per_plan, ci.violations_per_plan) = opt(runs, |m| m.violations_per_plan);
     (mean.violating_sensor_plans, ci.violating_sensor_plans) =
         opt(runs, |m| m.violating_sensor_plans);
+    (mean.gap_mean, ci.gap_mean) = opt(runs, |m| m.gap_mean);
+    (mean.gap_p50, ci.gap_p50) = opt(runs, |m| m.gap_p50);
+    (mean.joint_rounds, ci.joint_rounds) = opt(runs, |m| m.joint_rounds);
+    (mean.joint_at_target, ci.joint_at_target) = opt(runs, |m| m.joint_at_target);
+    (mean.joint_out_of_budget, ci.joint_out_of_budget) = opt(runs, |m| m.joint_out_of_budget);
     (mean, ci)
 }
 
@@ -300,6 +355,37 @@ mod tests {
         assert_eq!(mean.violations_per_plan, Some(0.4));
         assert!(ci.violating_plans.is_some_and(|c| c > 0.0));
         assert_eq!((mean.cells, mean.d4s), (2.0, 1.0));
+    }
+
+    #[test]
+    fn summarizes_certified_gaps_and_joint_rounds() {
+        let mut acc = RunAccumulator::default();
+        for gap in [0.004, 0.001, 0.0, 0.002] {
+            acc.add_plan_time(1.0);
+            acc.add_gap(gap);
+        }
+        for (rounds, stopped) in [
+            (3, JointStop::Gap),
+            (7, JointStop::Budget),
+            (2, JointStop::Settled),
+            (0, JointStop::Gap),
+        ] {
+            acc.add_joint(&JointReport {
+                rounds,
+                stopped,
+                micros: 1,
+            });
+        }
+        let m = acc.finish(0.0);
+        assert!(m.gap_mean.is_some_and(|g| (g - 0.00175).abs() < 1e-15));
+        // The nearest-rank median of four: the second smallest.
+        assert_eq!(m.gap_p50, Some(0.001));
+        assert_eq!(m.joint_rounds, Some(3.0));
+        assert_eq!(m.joint_at_target, Some(0.5));
+        assert_eq!(m.joint_out_of_budget, Some(0.25));
+        // A paper plan has no certificate, a non-joint plan no rounds.
+        let m = RunAccumulator::default().finish(0.0);
+        assert_eq!((m.gap_mean, m.gap_p50, m.joint_rounds), (None, None, None));
     }
 
     #[test]

@@ -21,17 +21,20 @@ fn opt(mean: Option<f64>, ci: Option<f64>, decimals: usize) -> String {
 /// then D4+S, detected by four or more sensors, TV), then ours (policy,
 /// detected once, calibration, plan round trip p50/p99, distinct cells
 /// occupied by the sensors, `viol%`: the percentage of plan responses with
-/// a separation violation, and `sviol%`: the percentage of sensor plans
-/// with one, `-` for local policies); NS shows the fleet
+/// a separation violation, `sviol%`: the percentage of sensor plans
+/// with one, `-` for local policies, and `gap%` and `gap50%`: the mean and
+/// the median over a run's plans of the certified gap, in percent, `-`
+/// without a certificate (the paper estimator, local policies)); NS shows
+/// the fleet
 /// (`drone:4,robot:6`) when the sensors have types, each mean ± the
 /// half-width of its 95% confidence interval over seeds.
 pub fn table(rows: &[Row]) -> String {
     let header = [
         "EN", "NS", "AD", "ZD", "AF", "D1S", "D2S", "D3S", "D4+S", "TV", "policy", "once", "calib",
-        "p50 ms", "p99 ms", "cells", "viol%", "sviol%",
+        "p50 ms", "p99 ms", "cells", "viol%", "sviol%", "gap%", "gap50%",
     ];
     let percent = |x: Option<f64>| x.map(|x| 100.0 * x);
-    let body: Vec<[String; 18]> = rows
+    let body: Vec<[String; 20]> = rows
         .iter()
         .map(|r| {
             let (m, c) = (&r.metrics, &r.ci95);
@@ -59,6 +62,8 @@ pub fn table(rows: &[Row]) -> String {
                     percent(c.violating_sensor_plans),
                     1,
                 ),
+                opt(percent(m.gap_mean), percent(c.gap_mean), 2),
+                opt(percent(m.gap_p50), percent(c.gap_p50), 2),
             ]
         })
         .collect();

@@ -272,6 +272,9 @@ function chart(id, values, fixedTop) {
 }
 
 const fmt = (v, d) => (v == null ? "–" : Number(v).toFixed(d));
+// A fraction as a percentage; "n/a" when the run's plans carry no
+// certificate (the paper estimator, local policies).
+const gapText = (v) => (!init || !init.certified ? "n/a" : v == null ? "–" : `${(100 * v).toFixed(3)}%`);
 
 function panel(f) {
   const st = $("step");
@@ -293,11 +296,17 @@ function panel(f) {
   $("m-cells-mean").textContent = f.step ? fmt(m.cells_mean, 2) : "–";
   $("m-viol").textContent = m.violations == null ? "–" : String(m.violations);
   $("m-viol-mean").textContent = m.violating_plans == null ? "–" : `${fmt(100 * m.violating_plans, 1)}%`;
+  $("m-gap").textContent = gapText(m.gap);
+  $("m-gap").dataset.gap = m.gap == null ? "" : String(m.gap);
+  $("m-gap-mean").textContent = gapText(m.gap_mean);
+  $("row-joint").hidden = m.joint_rounds == null;
+  $("m-joint").textContent = m.joint_rounds == null ? "–" : String(m.joint_rounds);
   chart("c-ad", f.series.ad);
   chart("c-af", f.series.af, 1);
   chart("c-once", f.series.once, 1);
   chart("c-calib", f.series.calibration);
   chart("c-plan", f.series.plan_ms);
+  chart("c-gap", f.series.gap);
   const body = $("sensor-table").tBodies[0];
   while (body.rows.length > f.sensors.length) body.deleteRow(-1);
   while (body.rows.length < f.sensors.length) {

@@ -1,8 +1,9 @@
 //! The live view in a real browser: a headless Chromium driven through
 //! WebDriver (chromedriver, started here on a free port) opens the page of
 //! a live run served on a loopback port 0, and the DOM is checked: the step
-//! counter advances, every sensor is drawn, the metrics update, pause stops
-//! the counter, step advances it by one, and the `explain` switch draws.
+//! counter advances, every sensor is drawn, the metrics update, the plan's
+//! certified gap is shown, pause stops the counter, step advances it by
+//! one, and the `explain` switch draws.
 //! A screenshot goes to the target directory.
 //!
 //! Without a browser this test FAILS: `.ci/run` installs Debian's
@@ -217,6 +218,25 @@ async fn live_view_in_headless_chromium() {
         assert!(v.is_finite() && v >= 0.0, "#{id} = {v}");
     }
 
+    // An exact plan carries its certificate: the page shows each step's
+    // certified gap as a percentage, the one in the frame, and charts it.
+    for id in ["m-gap", "m-gap-mean"] {
+        let text = c
+            .find(Locator::Id(id))
+            .await
+            .expect("gap")
+            .text()
+            .await
+            .expect("text");
+        let v: f64 = text
+            .strip_suffix('%')
+            .and_then(|t| t.parse().ok())
+            .unwrap_or_else(|| panic!("#{id} is not a percentage: {text:?}"));
+        assert!((0.0..=100.0).contains(&v), "#{id} = {v}%");
+    }
+    let gap_chart = c.find(Locator::Id("c-gap")).await.expect("#c-gap");
+    assert!(int_attr(&gap_chart, "data-points").await >= 2);
+
     // Pause stops the counter.
     c.find(Locator::Id("pause"))
         .await
@@ -258,6 +278,26 @@ async fn live_view_in_headless_chromium() {
     .await;
     tokio::time::sleep(Duration::from_millis(500)).await;
     assert_eq!(step_now(&c).await, paused_at + 1, "step did more than one");
+
+    // Paused, the page holds still: the gap shown is the frame's, the one
+    // the plan response carried (`bound.gap`), as a percentage.
+    let gap = c.find(Locator::Id("m-gap")).await.expect("#m-gap");
+    let raw: f64 = gap
+        .attr("data-gap")
+        .await
+        .expect("attribute")
+        .and_then(|g| g.parse().ok())
+        .expect("the frame's gap");
+    assert!((0.0..=1.0).contains(&raw), "gap {raw}");
+    let shown = gap.text().await.expect("text");
+    let pct: f64 = shown
+        .strip_suffix('%')
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("#m-gap is not a percentage: {shown:?}"));
+    assert!(
+        (pct - 100.0 * raw).abs() <= 0.0005 + 1e-9,
+        "{shown} for {raw}"
+    );
 
     // The explain switch draws sensor 0's search values.
     c.find(Locator::Id("explain"))

@@ -472,8 +472,8 @@ fn the_command_line_takes_a_minimum_separation() {
     let col = |name| columns.iter().position(|&c| c == name);
     assert_eq!(col("D4+S"), col("D3S").map(|i| i + 1), "{header}");
     assert_eq!(
-        &columns[columns.len() - 3..],
-        ["cells", "viol%", "sviol%"],
+        &columns[columns.len() - 5..],
+        ["cells", "viol%", "sviol%", "gap%", "gap50%"],
         "{header}"
     );
     let report: serde_json::Value =
@@ -486,4 +486,8 @@ fn the_command_line_takes_a_minimum_separation() {
     assert!(run["metrics"]["violating_plans"].is_number());
     assert!(run["metrics"]["violations_per_plan"].is_number());
     assert!(run["metrics"]["violating_sensor_plans"].is_number());
+    // The paper estimator has no certificate: no gap, shown as `-`.
+    assert!(run["metrics"]["gap_mean"].is_null());
+    let row = table.lines().nth(1).expect("a row");
+    assert_eq!(row.split_whitespace().last(), Some("-"), "{row}");
 }
