@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Runs every command the READMEs show, in a form that ends quickly, so a
+"""Runs every command the READMEs and the pages under docs/ show, in a form that ends quickly, so a
 command that does not run as written on a fresh clone fails CI.
 
 Commands are the `cargo …` and `bash …` lines of ```sh blocks and the
@@ -19,7 +19,7 @@ import shlex
 import subprocess
 import sys
 
-FILES = ["README.md", "loadtest/README.md"]
+FILES = ["README.md", "loadtest/README.md", "sim/README.md"]
 START = re.compile(r"^(?:[A-Z_]+=\S*\s+)*(cargo|bash)\s")
 
 
@@ -62,7 +62,8 @@ def runnable(command: str) -> list[str]:
 def main() -> int:
     root = pathlib.Path(__file__).resolve().parent.parent
     commands = []
-    for name in FILES:
+    pages = sorted(str(p.relative_to(root)) for p in (root / "docs").glob("*.md"))
+    for name in [*FILES, *pages]:
         for command in shown((root / name).read_text()):
             if command not in commands:
                 commands.append(command)

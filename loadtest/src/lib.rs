@@ -11,10 +11,12 @@
 //!   HTTP efficiency.
 //! - [`session`]: session mode: a session's steps replayed in process
 //!   ([`session::session_step`]), timed beside the stateless plans.
+//! - [`certify`]: the certified gap and plan time of each coordination.
 //! - [`report`]: the summary of a whole `run.sh` session.
 //!
 //! The method and the figures are in the crate's `README.md`.
 
+pub mod certify;
 pub mod generator;
 pub mod inproc;
 pub mod report;

@@ -8,6 +8,7 @@
 //! vigil-loadtest inproc [...]              in-process plan time of the same requests
 //! vigil-loadtest inproc --session [...]    in-process session step time of the same states
 //! vigil-loadtest summarize [...]           combine run.sh's results, HTTP efficiency
+//! vigil-loadtest certify [...]             certified gap and plan time per coordination
 //! ```
 
 use std::path::{Path, PathBuf};
@@ -21,6 +22,7 @@ use std::sync::Arc;
 
 use vigil::planner::{PlanRequest, Planner};
 
+use vigil_loadtest::certify;
 use vigil_loadtest::generator::{self, RunConfig, Target};
 use vigil_loadtest::inproc;
 use vigil_loadtest::report::Session;
@@ -64,6 +66,30 @@ enum Cmd {
     /// Combine the results of run.sh (each file optional) and derive the
     /// HTTP efficiency.
     Summarize(SummarizeArgs),
+    /// Plan the same requests with each coordination (in process, one
+    /// thread) and report the certified gap and the plan time of each.
+    Certify(CertifyArgs),
+}
+
+#[derive(Debug, Args)]
+struct CertifyArgs {
+    /// File of plan request bodies; generated when absent.
+    #[arg(long)]
+    requests: Option<PathBuf>,
+    /// Coordinations to compare, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "priority,iterated,joint")]
+    coordinations: Vec<String>,
+    /// `joint`'s time budget, ms (the server's default when absent).
+    #[arg(long)]
+    budget_ms: Option<usize>,
+    /// `joint`'s gap target (the server's default when absent).
+    #[arg(long)]
+    gap_target: Option<f64>,
+    /// Write the figures as JSON to this file.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    #[command(flatten)]
+    workload: WorkloadArgs,
 }
 
 /// Which endpoint a run hits.
@@ -322,6 +348,7 @@ fn main() -> ExitCode {
         Some(Cmd::Gen(a)) => gen_cmd(&a),
         Some(Cmd::Inproc(a)) => inproc_cmd(&a),
         Some(Cmd::Summarize(a)) => summarize_cmd(&a),
+        Some(Cmd::Certify(a)) => certify_cmd(&a),
         None => run_cmd(&cli.run),
     };
     match result {
@@ -369,6 +396,53 @@ fn inproc_cmd(a: &InprocArgs) -> Result<()> {
     );
     if let Some(out) = &a.out {
         write_json(out, &r)?;
+    }
+    Ok(())
+}
+
+fn certify_cmd(a: &CertifyArgs) -> Result<()> {
+    let planner = requests::planner_for(&a.workload.scenario)?;
+    let reqs: Vec<PlanRequest> = a
+        .workload
+        .requests(a.requests.as_deref())?
+        .into_iter()
+        .map(|r| PlanRequest {
+            budget_ms: a.budget_ms.map(Into::into).or(r.budget_ms),
+            gap_target: a.gap_target.or(r.gap_target),
+            ..r
+        })
+        .collect();
+    let modes = a
+        .coordinations
+        .iter()
+        .map(|c| {
+            serde_json::from_value(serde_json::Value::String(c.clone()))
+                .with_context(|| format!("unknown coordination {c:?}"))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let rows = certify::measure(&planner, &reqs, &modes)?;
+    println!(
+        "certified gap on {} ({} requests, mean {:.1} targets), one thread:",
+        planner.scenario.id,
+        reqs.len(),
+        mean_targets(&reqs)
+    );
+    for r in &rows {
+        println!(
+            "  {:<9} gap median {:.4}%  p95 {:.4}%  max {:.4}%   value mean {:.4}   plan median {:.3} ms  p95 {:.3} ms",
+            serde_json::to_value(r.coordination)?
+                .as_str()
+                .unwrap_or("?"),
+            100.0 * r.median_gap,
+            100.0 * r.p95_gap,
+            100.0 * r.max_gap,
+            r.mean_value,
+            r.median_ms,
+            r.p95_ms
+        );
+    }
+    if let Some(out) = &a.out {
+        write_json(out, &rows)?;
     }
     Ok(())
 }
