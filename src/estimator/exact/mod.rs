@@ -27,7 +27,7 @@ use crate::stats::Stats;
 /// spread over a larger block of a large grid gets no relaxation (its
 /// certificate falls back to the marginal bound), so the memory and the
 /// time of one step of it stay small.
-const MAX_ELEMENTS: usize = 1 << 18;
+const MAX_ELEMENTS: usize = 1 << 16;
 
 /// The exact conditional expectation of the count in `F_k` at step `t`:
 /// the reported targets whose straight-line position is in `F_k`, plus
