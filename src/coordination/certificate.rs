@@ -422,14 +422,17 @@ impl<'f, 'a> Relaxation<'f, 'a> {
                         }
                     }
                 }
-                for b in 0..=el.nb {
-                    for a in 1..=el.na {
-                        rects[b * w + a] += rects[b * w + a - 1];
+                for row in rects.chunks_exact_mut(w) {
+                    let mut acc = 0.0;
+                    for x in row {
+                        acc += *x;
+                        *x = acc;
                     }
                 }
                 for b in 1..=el.nb {
-                    for a in 0..=el.na {
-                        rects[b * w + a] += rects[(b - 1) * w + a];
+                    let (done, rest) = rects.split_at_mut(b * w);
+                    for (x, above) in rest[..w].iter_mut().zip(&done[(b - 1) * w..]) {
+                        *x += *above;
                     }
                 }
                 cover
@@ -437,15 +440,22 @@ impl<'f, 'a> Relaxation<'f, 'a> {
             .collect();
         // The subgradient in the ratios μ_e / w_e, `w_e·(cover_e − 1)` on
         // the active pieces (0 elsewhere): its norm, then the step.
+        // Row by row: rectangle (a, b) is `b·na + a` in the weights and
+        // `b·(na + 1) + a` in the covers.
+        let rows = |t: usize| {
+            let (el, na) = (&self.steps[t], self.steps[t].na);
+            el.mass
+                .chunks_exact(na)
+                .zip(self.active_rects[t].chunks_exact(na))
+                .zip(covers[t].chunks_exact(na + 1))
+        };
         let mut norm = 0.0;
         for (t, el) in self.steps.iter().enumerate() {
             let (w, cover) = (el.na + 1, &covers[t]);
-            let mask = &self.active_rects[t];
-            for b in 0..el.nb {
-                for a in 0..el.na {
-                    let e = b * el.na + a;
-                    if mask[e] {
-                        norm += (el.mass[e] * (cover[b * w + a] - 1.0)).powi(2);
+            for ((mass, mask), cover) in rows(t) {
+                for ((&m, &on), &c) in mass.iter().zip(mask).zip(cover) {
+                    if on {
+                        norm += (m * (c - 1.0)).powi(2);
                     }
                 }
             }
@@ -457,15 +467,17 @@ impl<'f, 'a> Relaxation<'f, 'a> {
         }
         if norm > 0.0 {
             let theta = self.lambda * (upper - lower).max(0.0) / norm;
+            let mut ratios = std::mem::take(&mut self.ratio);
             for (t, el) in self.steps.iter().enumerate() {
                 let (w, cover) = (el.na + 1, &covers[t]);
-                let (mask, ratio) = (&self.active_rects[t], &mut self.ratio[t]);
-                for b in 0..el.nb {
-                    for a in 0..el.na {
-                        let e = b * el.na + a;
-                        if mask[e] {
-                            let g = el.mass[e] * (cover[b * w + a] - 1.0);
-                            ratio[e] = (ratio[e] - theta * g).clamp(0.0, 1.0);
+                let ratio = &mut ratios[t];
+                let (rect_ratios, _) = ratio.split_at_mut(el.mass.len());
+                for (((mass, mask), cover), ratio) in
+                    rows(t).zip(rect_ratios.chunks_exact_mut(el.na))
+                {
+                    for (((&m, &on), &c), r) in mass.iter().zip(mask).zip(cover).zip(ratio) {
+                        if on {
+                            *r = (*r - theta * (m * (c - 1.0))).clamp(0.0, 1.0);
                         }
                     }
                 }
@@ -475,6 +487,7 @@ impl<'f, 'a> Relaxation<'f, 'a> {
                     *r = (*r - theta * (known[j] - 1.0)).clamp(0.0, 1.0);
                 }
             }
+            self.ratio = ratios;
         }
     }
 }
