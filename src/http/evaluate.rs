@@ -11,7 +11,7 @@ use super::error::ApiError;
 use super::extract::{Json, Path, QueuedJson};
 use super::middleware::RequestStart;
 use super::openapi::{self as doc, examples};
-use super::plan::{CancelOnDrop, resolve_scenario};
+use super::plan::{CancelOnDrop, with_scenario};
 use crate::coordination::Coordination;
 use crate::cost;
 use crate::evaluate::{EvaluateInput, EvaluateRequest, EvaluateResponse};
@@ -115,15 +115,6 @@ pub async fn evaluate_inline(
     start: Option<Extension<RequestStart>>,
     QueuedJson(body): QueuedJson<serde_json::Value>,
 ) -> Result<Json<EvaluateResponse>, ApiError> {
-    let serde_json::Value::Object(mut fields) = body else {
-        return Err(ApiError::MalformedBody(
-            "the body must be a JSON object".into(),
-        ));
-    };
-    let scenario_id = fields.remove("scenario_id");
-    let inline = fields.remove("scenario");
-    let req: EvaluateRequest = serde_json::from_value(serde_json::Value::Object(fields))
-        .map_err(|e| ApiError::MalformedBody(e.to_string()))?;
-    let planner = resolve_scenario(&state, start, scenario_id, inline).await?;
+    let (planner, req): (_, EvaluateRequest) = with_scenario(&state, start, body).await?;
     Ok(Json(evaluate_admitted(&state, start, planner, &req).await?))
 }

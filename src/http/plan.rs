@@ -192,6 +192,18 @@ pub async fn plan_inline(
     start: Option<Extension<RequestStart>>,
     QueuedJson(body): QueuedJson<serde_json::Value>,
 ) -> Result<Json<PlanResponse>, ApiError> {
+    let (planner, req): (_, PlanRequest) = with_scenario(&state, start, body).await?;
+    Ok(Json(plan_admitted(&state, start, planner, &req).await?))
+}
+
+/// A body that names its scenario as `POST /v1/plan`'s does: the planner
+/// of its `scenario_id` or inline `scenario` (see [`resolve_scenario`]),
+/// and the other fields read as `T`.
+pub(super) async fn with_scenario<T: serde::de::DeserializeOwned>(
+    state: &AppState,
+    start: Option<Extension<RequestStart>>,
+    body: serde_json::Value,
+) -> Result<(Arc<Planner>, T), ApiError> {
     let serde_json::Value::Object(mut fields) = body else {
         return Err(ApiError::MalformedBody(
             "the body must be a JSON object".into(),
@@ -199,10 +211,10 @@ pub async fn plan_inline(
     };
     let scenario_id = fields.remove("scenario_id");
     let inline = fields.remove("scenario");
-    let req: PlanRequest = serde_json::from_value(serde_json::Value::Object(fields))
+    let req: T = serde_json::from_value(serde_json::Value::Object(fields))
         .map_err(|e| ApiError::MalformedBody(e.to_string()))?;
-    let planner = resolve_scenario(&state, start, scenario_id, inline).await?;
-    Ok(Json(plan_admitted(&state, start, planner, &req).await?))
+    let planner = resolve_scenario(state, start, scenario_id, inline).await?;
+    Ok((planner, req))
 }
 
 /// The planner of the scenario a body names: `scenario_id` (registered,
