@@ -55,15 +55,16 @@ pub struct Violations {
 
 /// Counts the breaches of separation `d` among `paths` (each the cells at
 /// steps 1..=T; paths of different lengths are compared over the shorter).
-pub fn count(paths: &[Vec<Cell>], d: usize) -> Violations {
+pub fn count<P: AsRef<[Cell]>>(paths: &[P], d: usize) -> Violations {
     let mut per_sensor = vec![0u32; paths.len()];
     let mut pairs = 0;
     if d > 0 {
         for (i, a) in paths.iter().enumerate() {
             for (j, b) in paths.iter().enumerate().skip(i + 1) {
                 let n = a
+                    .as_ref()
                     .iter()
-                    .zip(b)
+                    .zip(b.as_ref())
                     .filter(|&(&p, &q)| too_close(p, q, d))
                     .count() as u32;
                 per_sensor[i] += n;

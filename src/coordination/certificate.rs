@@ -265,11 +265,6 @@ impl<'f, 'a> Relaxation<'f, 'a> {
         })
     }
 
-    /// The smallest bound computed so far.
-    pub fn best(&self) -> f64 {
-        self.best
-    }
-
     /// One subgradient step from the last weights evaluated towards
     /// `lower` (a plan's value, at most the optimum), then `U` at the new
     /// weights (a valid bound), which it returns.

@@ -9,8 +9,8 @@
 //!    result if it has no more separation violations and more value. The
 //!    starts alternate between the paths the relaxation's weights draw
 //!    each sensor to (where the bound says value may be left) and the
-//!    current plan with a few sensors, chosen at random, sent back to
-//!    their solo bests: a large-neighbourhood search.
+//!    current plan with a third of the sensors, chosen at random, sent to
+//!    the relaxation's paths: a large-neighbourhood search.
 //!
 //! The returned plan never has less value or more violations than
 //! `Iterated`'s. The random choices come from a generator seeded from the
@@ -25,11 +25,10 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use super::MAX_ROUNDS;
-use super::certificate::Certifier;
+use super::certificate::{Bound, Certifier};
 use super::fleet::{Fleet, SensorPlan, path_slices};
 use super::rounds::best_responses;
 use crate::cancel::Cancelled;
-use crate::scenario::Cell;
 use crate::separation;
 
 /// The certified gap `joint` stops at by default.
@@ -109,20 +108,13 @@ pub fn improve(
     let score = |plans: &[SensorPlan]| -> (u32, f64) {
         let paths = path_slices(plans);
         let value = fleet.by_step(&paths, order).iter().sum();
-        let owned: Vec<Vec<Cell>> = plans.iter().map(|p| p.path.clone()).collect();
-        (separation::count(&owned, d).pairs, value)
+        (separation::count(&paths, d).pairs, value)
     };
     let (mut pairs, mut value) = score(plans);
     let mut rounds = 0;
     let mut idle = 0;
     let stopped = loop {
-        let upper = certifier.upper().max(value);
-        let gap = if upper > 0.0 {
-            (upper - value) / upper
-        } else {
-            0.0
-        };
-        if gap <= settings.gap_target {
+        if Bound::new(value, [certifier.upper()]).gap <= settings.gap_target {
             break JointStop::Gap;
         }
         if Instant::now() >= deadline {

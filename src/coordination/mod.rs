@@ -137,9 +137,6 @@ pub fn coordinate(
         ..
     } = *fleet;
     let n = starts.len();
-    let plan_one = |i: usize, fill: &mut dyn FnMut(usize, &mut ValueGrid), avoid: Vec<&[Cell]>| {
-        fleet.plan_one(i, fill, avoid)
-    };
     // The paths of `sensors`, when there is a separation to keep.
     let paths =
         |plans: &[SensorPlan], sensors: &mut dyn Iterator<Item = usize>| -> Vec<Vec<Cell>> {
@@ -152,7 +149,7 @@ pub fn coordinate(
     let mut plans: Vec<SensorPlan> = (0..n)
         .into_par_iter()
         .with_min_len(crate::parallel::min_len())
-        .map(|i| plan_one(i, &mut |t, g| est.fill(i, starts[i], t, &[], g), Vec::new()))
+        .map(|i| fleet.plan_one(i, &mut |t, g| est.fill(i, starts[i], t, &[], g), Vec::new()))
         .collect();
     cancel.check()?;
     let solo: Vec<(f64, Vec<Cell>)> = plans.iter().map(|p| (p.value, p.path.clone())).collect();
@@ -187,7 +184,7 @@ pub fn coordinate(
             search(grid, starts[i])
         } else {
             let looks = fleet.looks_by_step(&path_slices(plans), above, i);
-            plan_one(
+            fleet.plan_one(
                 i,
                 &mut |t, g| match &looks[t - 1][..] {
                     [] => g.copy_step(t, &alone[i]),
@@ -212,7 +209,7 @@ pub fn coordinate(
         // too close to another that can have fewer violations against every
         // other path takes that path, the ranks below it plan again in
         // order, and the change stays if fewer pairs are too close.
-        let mut total = separation::count(&all_paths(&plans), d);
+        let mut total = separation::count(&path_slices(&plans), d);
         while total.pairs > 0 && repairs < MAX_REPAIRS {
             repairs += 1;
             let mut improved = false;
@@ -232,7 +229,7 @@ pub fn coordinate(
                     trial[order[below]] = ranked(&trial, below, false);
                     cancel.check()?;
                 }
-                let after = separation::count(&all_paths(&trial), d);
+                let after = separation::count(&path_slices(&trial), d);
                 if after.pairs < total.pairs {
                     (plans, total) = (trial, after);
                     improved = true;
@@ -271,7 +268,7 @@ pub fn coordinate(
     } else {
         None
     };
-    let violations = separation::count(&all_paths(&plans), d);
+    let violations = separation::count(&path_slices(&plans), d);
     Ok(Coordinated {
         plans,
         order,
@@ -282,8 +279,4 @@ pub fn coordinate(
         bound,
         joint: report,
     })
-}
-
-fn all_paths(plans: &[SensorPlan]) -> Vec<Vec<Cell>> {
-    plans.iter().map(|p| p.path.clone()).collect()
 }
