@@ -80,11 +80,14 @@
 //! | paper iterated: cells × n × (1 + ov) | 7.370e-6 | every lower-ranked sensor's change |
 
 use crate::coordination::Coordination;
-use crate::estimator::SourceRays;
+use crate::estimator::{
+    INDEX_CROSSINGS_PER_CELL, MAX_SMALL_GRID, MIN_INDEX_CROSSINGS, ONE_WINDOW_RECTANGLES,
+    SourceRays,
+};
 use crate::geometry::Point;
 use crate::planner::{EstimatorKind, Observed, PlanInput, Planner};
 use crate::scenario::{Cell, FovSpec, Scenario, Source};
-use crate::stats::angular_span;
+use crate::stats::{ESCAPE_SAMPLES, angular_span};
 
 /// The precompute model: each term's name and coefficient, milliseconds
 /// per unit, in the order of [`precompute_terms`].
@@ -185,11 +188,13 @@ pub fn precompute_terms(s: &Scenario) -> [f64; 7] {
         // decide: no grid past what one size of square gives, no index past
         // ~100 bytes a cell.
         let one = (2.0 * s.cols as f64 + 1.0) * (2.0 * s.rows as f64 + 1.0);
-        if nx * ny <= one.max((1u64 << 22) as f64) {
+        if nx * ny <= one.max(MAX_SMALL_GRID as f64) {
             t[4] = nx * ny * cover;
             t[5] = nx * ny * cone;
             let rays: f64 = source_rays(s).iter().map(|r| r.1).sum();
-            if rays * (nx + ny) <= (5.0 * cells).max((1u64 << 20) as f64) {
+            if rays * (nx + ny)
+                <= (INDEX_CROSSINGS_PER_CELL as f64 * cells).max(MIN_INDEX_CROSSINGS as f64)
+            {
                 t[6] = rays * (nx + ny);
             }
         }
@@ -341,7 +346,7 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> [f64; 18] {
         let pieces = n as f64 * per_look;
         t[3] = pieces * (2.0 + pieces / all_rays.max(1.0)).log2();
     }
-    let whole = grid.is_some_and(|g| g.dims().0 * g.dims().1 <= 1 << 16);
+    let whole = grid.is_some_and(|g| g.dims().0 * g.dims().1 <= ONE_WINDOW_RECTANGLES);
     if let (Some(g), true) = (grid, whole) {
         t[4] = big_t as f64 * look_rays;
         t[5] = (big_t * g.dims().0 * g.dims().1) as f64;
@@ -443,7 +448,7 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> [f64; 18] {
         }
         if !exact {
             let reach = (2 * ty.speed * big_t + 1) as f64;
-            t[14] += reach * reach + known + 512.0 * (rays.len() as f64 + classes);
+            t[14] += reach * reach + known + ESCAPE_SAMPLES as f64 * (rays.len() as f64 + classes);
         }
     }
     if grid.is_some() && !whole {
@@ -454,7 +459,7 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> [f64; 18] {
             let b = bbox[step];
             let size = ((b.1 - b.0) * (b.3 - b.2)) as f64;
             t[6] += per_look
-                * if size <= 65536f64.max(2.0 * total[step]) {
+                * if size <= (ONE_WINDOW_RECTANGLES as f64).max(2.0 * total[step]) {
                     size * n as f64 / fov_rects
                 } else {
                     blocks[step]

@@ -28,6 +28,7 @@ pub mod estimator;
 pub mod evaluate;
 pub mod geometry;
 pub mod http;
+pub mod limits;
 mod parallel;
 pub mod planner;
 pub mod scenario;

@@ -10,26 +10,19 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::cancel::{CancelToken, Cancelled, Progress};
-use crate::coordination::joint::MAX_BUDGET_MS;
 use crate::coordination::{Bound, Coordination, Fleet, JointReport, JointSettings, coordinate};
 use crate::estimator::{
     ElementaryGrid, Estimator, ExactEstimator, PaperEstimator, SourceRays, Target,
 };
 use crate::geometry::Point;
+use crate::limits::{
+    MAX_BUDGET_MS, MAX_HISTORY_POSITIONS, MAX_HISTORY_STEPS, MAX_SENSORS, MAX_TARGETS,
+};
 use crate::scenario::{
     Cell, DEFAULT_TYPE, Integer, Look, Scenario, ValidationError, check_horizon,
     check_min_separation,
 };
 use crate::stats::Stats;
-
-/// Most sensors in one request.
-pub const MAX_SENSORS: usize = 256;
-/// Most targets in one request.
-pub const MAX_TARGETS: usize = 20_000;
-/// Most steps of history.
-pub const MAX_HISTORY_STEPS: usize = 32;
-/// Most positions in one history step.
-pub const MAX_HISTORY_POSITIONS: usize = 256;
 
 /// Which estimator of `n̂(k,t)` to use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema)]

@@ -3,7 +3,7 @@
 //!
 //! # Motion model
 //!
-//! A sensor of speed `m` (1 ≤ `m` ≤ [`MAX_SPEED`]) makes, in one step, up to
+//! A sensor of speed `m` (1 ≤ `m` ≤ [`MAX_SENSOR_SPEED`]) makes, in one step, up to
 //! `m` king moves (each to one of its 8 neighbours); every intermediate and
 //! final cell must be *free*, that is on the lattice and not blocked. The
 //! offsets reachable in one step from offset `o` are therefore those within
@@ -68,6 +68,8 @@ use std::cell::RefCell;
 use std::fmt;
 use std::sync::Arc;
 
+use crate::limits::MAX_SENSOR_SPEED;
+
 /// The nine moves `(dc, dr)` of one step at speed 1, in tie-breaking order
 /// (the same as `step_displacements(1)`).
 pub const MOVES: [(i32, i32); 9] = [
@@ -81,9 +83,6 @@ pub const MOVES: [(i32, i32); 9] = [
     (0, 1),
     (1, 1),
 ];
-
-/// The largest supported speed (king moves per step).
-pub const MAX_SPEED: usize = 3;
 
 /// The `N = (2m+1)²` displacements of speed `m` in tie-breaking order: by
 /// Chebyshev ring (stay first), then `dr` ascending, then `dc` ascending.
@@ -125,13 +124,13 @@ static STEPS_3: [(i32, i32); 49] = ring_order(3);
 ///
 /// # Panics
 ///
-/// If `speed` is not in `1..=MAX_SPEED`.
+/// If `speed` is not in `1..=MAX_SENSOR_SPEED`.
 pub fn step_displacements(speed: usize) -> &'static [(i32, i32)] {
     match speed {
         1 => &STEPS_1,
         2 => &STEPS_2,
         3 => &STEPS_3,
-        _ => panic!("speed {speed} is not in 1..={MAX_SPEED}"),
+        _ => panic!("speed {speed} is not in 1..={MAX_SENSOR_SPEED}"),
     }
 }
 
@@ -329,7 +328,7 @@ impl ValueGrid {
     }
 
     /// An empty grid for horizon `horizon`, speed `speed` (king moves per
-    /// step, `1..=MAX_SPEED`) and the free cells given by `free(dc, dr)`:
+    /// step, `1..=MAX_SENSOR_SPEED`) and the free cells given by `free(dc, dr)`:
     /// whether the cell at offset `(dc, dr)` from the start is on the lattice
     /// and unblocked. `free` is called only for `|dc|, |dr| ≤ speed·horizon`
     /// (at most once per offset); the start `(0, 0)` is always free.
@@ -358,11 +357,11 @@ impl ValueGrid {
     ///
     /// # Panics
     ///
-    /// If `speed` is not in `1..=MAX_SPEED`.
+    /// If `speed` is not in `1..=MAX_SENSOR_SPEED`.
     pub fn with_motion(horizon: usize, speed: usize, free: impl Fn(i32, i32) -> bool) -> Self {
         assert!(
-            (1..=MAX_SPEED).contains(&speed),
-            "speed {speed} is not in 1..={MAX_SPEED}"
+            (1..=MAX_SENSOR_SPEED).contains(&speed),
+            "speed {speed} is not in 1..={MAX_SENSOR_SPEED}"
         );
         let e = (speed * horizon) as i32;
         let side = 2 * speed * horizon + 1;

@@ -30,9 +30,6 @@
 use crate::scenario::Cell;
 use crate::search::ValueGrid;
 
-/// Largest minimum separation accepted, cells.
-pub const MAX_MIN_SEPARATION: usize = 16;
-
 /// True when cells `a` and `b` are closer than `d` (Chebyshev distance,
 /// cells); never for `d = 0`.
 #[inline]

@@ -51,14 +51,11 @@ use utoipa::ToSchema;
 
 use crate::coordination::Coordination;
 use crate::geometry::Point;
+use crate::limits::{DEFAULT_HISTORY_STEPS, MAX_HISTORY_STEPS, MAX_TARGETS};
 use crate::planner::{
-    EstimatorKind, Id, MAX_HISTORY_STEPS, MAX_TARGETS, Observed, PlanRequest, Planner, PositionIn,
-    SensorIn, TargetIn,
+    EstimatorKind, Id, Observed, PlanRequest, Planner, PositionIn, SensorIn, TargetIn,
 };
 use crate::scenario::{Integer, ValidationError};
-
-/// Steps of history a session keeps by default.
-pub const DEFAULT_HISTORY_STEPS: usize = 16;
 
 /// A session's defaults for its steps; a step may override each but
 /// `history_steps`.

@@ -28,7 +28,8 @@ use rayon::prelude::*;
 
 use crate::cancel::{CancelToken, Cancelled, Progress};
 use crate::geometry::{Point, Region, gauss_legendre, inv_r_integral, wedge_inv_r_integral};
-use crate::scenario::{FovSpec, MAX_HORIZON, Scenario, Source};
+use crate::limits::MAX_HORIZON;
+use crate::scenario::{FovSpec, Scenario, Source};
 
 /// The statistics of every cell, row-major (`row·cols + col`).
 #[derive(Debug, Clone)]
@@ -218,7 +219,8 @@ impl Stats {
 }
 
 /// Angular samples per (cell, source) for the escape-time distribution.
-const ESCAPE_SAMPLES: usize = 512;
+/// The cost model predicts with it.
+pub const ESCAPE_SAMPLES: usize = 512;
 
 /// The statistical part of the paper's equation (1) at a sensor's own cell
 /// `Pi`, for every horizon: element `t` (1 ≤ t ≤ 12) is

@@ -12,13 +12,11 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use bytes::Bytes;
-use vigil::planner::{MAX_HISTORY_STEPS, MAX_SENSORS, PlanRequest, Planner};
+use vigil::limits::{MAX_HISTORY_STEPS, MAX_HORIZON, MAX_SENSORS};
+use vigil::planner::{PlanRequest, Planner};
 use vigil::scenario::builtins;
 
 use crate::workload::{SessionWorkload, Workload};
-
-/// Largest horizon the API accepts.
-const MAX_HORIZON: usize = 12;
 
 /// The planner of the built-in scenario `id` (its statistics computed now,
 /// a few milliseconds).

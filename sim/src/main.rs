@@ -121,7 +121,7 @@ struct Args {
     /// (random, local-force, stationary) keep it by moving each sensor, in
     /// sensor order, to its intended cell, else staying, else the nearest
     /// allowed legal move.
-    #[arg(long, value_parser = clap::value_parser!(u8).range(0..=vigil::separation::MAX_MIN_SEPARATION as i64))]
+    #[arg(long, value_parser = clap::value_parser!(u8).range(0..=vigil::limits::MAX_MIN_SEPARATION as i64))]
     min_separation: Option<u8>,
 }
 

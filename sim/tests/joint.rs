@@ -3,7 +3,8 @@
 //! the same request.
 
 use vigil::coordination::Coordination;
-use vigil::coordination::joint::{DEFAULT_GAP_TARGET, JointStop};
+use vigil::coordination::joint::JointStop;
+use vigil::limits::DEFAULT_GAP_TARGET;
 use vigil::scenario::Scenario;
 use vigil_sim::client::{Client, spawn_local_server};
 use vigil_sim::driver::{Start, checked_bound};

@@ -29,14 +29,9 @@ use super::certificate::{Bound, Certifier};
 use super::fleet::{Fleet, SensorPlan, path_slices};
 use super::rounds::best_responses;
 use crate::cancel::Cancelled;
+use crate::limits::{DEFAULT_BUDGET_MS, DEFAULT_GAP_TARGET};
 use crate::separation;
 
-/// The certified gap `joint` stops at by default.
-pub const DEFAULT_GAP_TARGET: f64 = 0.001;
-/// The time `joint` may take by default, milliseconds.
-pub const DEFAULT_BUDGET_MS: u64 = 20;
-/// The most time `joint` may be given, milliseconds.
-pub const MAX_BUDGET_MS: u64 = 1000;
 /// Steps of the relaxation per round: each costs about one search per
 /// sensor, a restart several rounds of them, and the bound needs tens of
 /// steps to settle.

@@ -17,8 +17,8 @@ use crate::geometry::{Point, Rect, wedge_inv_r_integral};
 use crate::scenario::{Cell, FovSpec, Heading, Scenario, Source};
 
 /// Elementary rectangles a grid may always have, whatever the lattice
-/// (a 32 MB prefix table).
-const MAX_SMALL_GRID: usize = 1 << 22;
+/// (a 32 MB prefix table). The cost model predicts with it.
+pub const MAX_SMALL_GRID: usize = 1 << 22;
 
 /// The grid, its prefix table of stationary mass, and each cell's block.
 #[derive(Debug, Clone)]

@@ -14,8 +14,11 @@ mod elementary;
 mod exact;
 mod paper;
 
-pub use elementary::ElementaryGrid;
-pub use exact::{ExactEstimator, RAYS_PER_PI, RAYS_PER_PI_SQUARE, SourceRays};
+pub use elementary::{ElementaryGrid, MAX_SMALL_GRID};
+pub use exact::{
+    ExactEstimator, INDEX_CROSSINGS_PER_CELL, MIN_INDEX_CROSSINGS, ONE_WINDOW_RECTANGLES,
+    RAYS_PER_PI, RAYS_PER_PI_SQUARE, SourceRays,
+};
 pub use paper::PaperEstimator;
 
 use crate::geometry::Point;

@@ -2,7 +2,8 @@
 
 use super::{Estimator, Target};
 use crate::geometry::Region;
-use crate::scenario::{Cell, Look, MAX_HORIZON, Scenario, all_certain};
+use crate::limits::MAX_HORIZON;
+use crate::scenario::{Cell, Look, Scenario, all_certain};
 use crate::stats::{Stats, paper_statistical_part};
 
 /// Equations (1) and (2) of the paper, read as follows for the sensor at

@@ -87,15 +87,11 @@ use tracing::Level;
 
 use self::cache::PlannerCache;
 use self::config::{Config, Settings};
+use crate::limits::MAX_BODY_BYTES;
 use crate::store::{PgStore, Store};
 
 pub use error::{ApiError, Problem};
 pub use registry::{JobLimits, Registry, precompute};
-
-/// Largest request body accepted, bytes. Large enough for a plan request
-/// with the most targets allowed ([`MAX_TARGETS`](crate::planner::MAX_TARGETS))
-/// written at full precision.
-pub const MAX_BODY_BYTES: usize = 4 * 1024 * 1024;
 
 /// Pieces of work that may wait for a rayon worker, per worker; past that,
 /// more are shed at once with 503. Eight plans of the reference workload

@@ -20,10 +20,9 @@ use super::registry::JobStatus;
 use super::{evaluate, health, middleware, plan, scenarios, sessions};
 use crate::coordination::Coordination;
 use crate::evaluate::SensorPathIn;
-use crate::planner::{
-    EstimatorKind, MAX_HISTORY_POSITIONS, Observed, PositionIn, SensorIn, TargetIn,
-};
-use crate::scenario::{Integer, MAX_SENSOR_TYPES, ScenarioSpec, ValidationError};
+use crate::limits::{MAX_HISTORY_POSITIONS, MAX_SENSOR_TYPES};
+use crate::planner::{EstimatorKind, Observed, PositionIn, SensorIn, TargetIn};
+use crate::scenario::{Integer, ScenarioSpec, ValidationError};
 
 /// Description of the whole API, the `info.description` of the document.
 const DESCRIPTION: &str = "\

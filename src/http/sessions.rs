@@ -24,9 +24,9 @@ use super::extract::{Json, Path, QueuedJson};
 use super::middleware::RequestStart;
 use super::openapi::{self as doc, examples};
 use super::plan::{plan_admitted, resolve_scenario};
-use crate::planner::{MAX_TARGETS, PlanResponse};
-use crate::scenario::{MAX_HORIZON, ValidationError};
-use crate::separation::MAX_MIN_SEPARATION;
+use crate::limits::{MAX_HORIZON, MAX_MIN_SEPARATION, MAX_TARGETS};
+use crate::planner::PlanResponse;
+use crate::scenario::ValidationError;
 use crate::session::{Session, SessionSettings, StepRequest, Track};
 
 type Shared = Arc<tokio::sync::Mutex<Session>>;

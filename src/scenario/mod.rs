@@ -12,6 +12,10 @@ use sha2::{Digest, Sha256};
 use utoipa::ToSchema;
 
 use crate::geometry::{Disk, Point, Rect, Region};
+use crate::limits::{
+    DEFAULT_HORIZON, MAX_CELL_STATS, MAX_CELLS, MAX_HORIZON, MAX_MIN_SEPARATION, MAX_NAME_CHARS,
+    MAX_POPULATION, MAX_SOURCES,
+};
 
 mod builtins;
 mod sensor;
@@ -22,30 +26,8 @@ pub use builtins::{
     site_fleet_spec, site_gates_spec, site_robot,
 };
 
-pub use sensor::{
-    DEFAULT_TYPE, Look, MAX_NO_GO, MAX_SENSOR_SPEED, MAX_SENSOR_TYPES, NoGoSpec, SensorType,
-    SensorTypeSpec, all_certain,
-};
-pub use source::{
-    Heading, MAX_SPEED_CLASSES, Source, SourceSpec, SpeedSpec, TargetClass, infer_heading,
-};
-
-/// Largest planning horizon accepted.
-pub const MAX_HORIZON: usize = 12;
-/// Largest number of cells in a lattice.
-pub const MAX_CELLS: usize = 4_000_000;
-/// Largest number of sources in a scenario.
-pub const MAX_SOURCES: usize = 64;
-/// Largest bound on the zone's population accepted: `Σ rate·diagonal/speed`
-/// over the target classes (the most targets the zone could hold at once if
-/// every one crossed its full diagonal). Keeps every statistic finite.
-pub const MAX_POPULATION: f64 = 1e9;
-/// Most per-cell statistics of a scenario whose sensor types have several
-/// fields of view: cells × distinct fields of view (each field of view has
-/// its own statistics of every cell).
-pub const MAX_CELL_STATS: usize = 8_000_000;
-/// Horizon used when a spec does not give one.
-pub const DEFAULT_HORIZON: usize = 3;
+pub use sensor::{DEFAULT_TYPE, Look, NoGoSpec, SensorType, SensorTypeSpec, all_certain};
+pub use source::{Heading, Source, SourceSpec, SpeedSpec, TargetClass, infer_heading};
 
 /// An input value outside its bounds. `field` is a JSON path into the
 /// request, `message` says the bound.
@@ -300,12 +282,12 @@ pub fn check_horizon(
 }
 
 /// Checks a minimum separation against
-/// `0..=`[`crate::separation::MAX_MIN_SEPARATION`]; `None` stays `None`.
+/// `0..=`[`MAX_MIN_SEPARATION`]; `None` stays `None`.
 pub fn check_min_separation(
     field: &str,
     d: Option<&Integer>,
 ) -> Result<Option<usize>, ValidationError> {
-    d.map(|d| d.check(field, 0..=crate::separation::MAX_MIN_SEPARATION))
+    d.map(|d| d.check(field, 0..=MAX_MIN_SEPARATION))
         .transpose()
 }
 
@@ -318,11 +300,11 @@ impl Scenario {
 
     fn build(spec: ScenarioSpec, id: Option<&str>) -> Result<Self, ValidationError> {
         if let Some(name) = &spec.name
-            && name.chars().count() > 200
+            && name.chars().count() > MAX_NAME_CHARS
         {
             return Err(ValidationError::new(
                 "name",
-                "must be at most 200 characters",
+                format!("must be at most {MAX_NAME_CHARS} characters"),
             ));
         }
         let width = finite_positive("zone.width", spec.zone.width)?;

@@ -14,13 +14,8 @@ use utoipa::ToSchema;
 
 use super::{FovSpec, Integer, ValidationError};
 use crate::geometry::Region;
+use crate::limits::{MAX_NO_GO, MAX_SENSOR_SPEED, MAX_SENSOR_TYPES};
 
-/// Most named sensor types of a scenario (besides `default`).
-pub const MAX_SENSOR_TYPES: usize = 8;
-/// Fastest sensor, cells (king moves) per step.
-pub const MAX_SENSOR_SPEED: usize = 3;
-/// Most no-go rectangles of a scenario.
-pub const MAX_NO_GO: usize = 256;
 /// Name of the type made of the scenario's top-level `fov`.
 pub const DEFAULT_TYPE: &str = "default";
 

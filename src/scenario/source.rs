@@ -14,9 +14,7 @@ use utoipa::ToSchema;
 
 use super::ValidationError;
 use crate::geometry::{Point, Rect};
-
-/// Most speed classes of one source.
-pub const MAX_SPEED_CLASSES: usize = 8;
+use crate::limits::MAX_SPEED_CLASSES;
 
 /// Direction a source's takeoff half-plane faces.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema)]

@@ -183,7 +183,7 @@ proptest! {
 #[test]
 fn step_displacements_are_rings_then_rows() {
     assert_eq!(step_displacements(1), &MOVES);
-    for m in 1..=MAX_SPEED {
+    for m in 1..=MAX_SENSOR_SPEED {
         let d = step_displacements(m);
         let mi = m as i32;
         assert_eq!(d.len(), (2 * m + 1) * (2 * m + 1));

@@ -529,9 +529,10 @@ fn every_routed_path_is_documented() {
 /// The bounds written into the schemas are the code's constants.
 #[test]
 fn schema_bounds_are_the_code_limits() {
-    use vigil::planner::{MAX_HISTORY_POSITIONS, MAX_HISTORY_STEPS, MAX_SENSORS, MAX_TARGETS};
-    use vigil::scenario::{MAX_HORIZON, MAX_SOURCES, MAX_SPEED_CLASSES};
-    use vigil::separation::MAX_MIN_SEPARATION;
+    use vigil::limits::{
+        MAX_HISTORY_POSITIONS, MAX_HISTORY_STEPS, MAX_HORIZON, MAX_MIN_SEPARATION, MAX_SENSORS,
+        MAX_SOURCES, MAX_SPEED_CLASSES, MAX_TARGETS,
+    };
     let doc = document();
     let schemas = &doc["components"]["schemas"];
     for request in ["PlanRequest", "PlanRequestById", "PlanRequestWithScenario"] {

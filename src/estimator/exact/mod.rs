@@ -11,9 +11,12 @@ mod windows;
 
 use rayon::prelude::*;
 
+pub use rays::{
+    INDEX_CROSSINGS_PER_CELL, MIN_INDEX_CROSSINGS, RAYS_PER_PI, RAYS_PER_PI_SQUARE, SourceRays,
+};
 use rays::{LookKey, look_key};
-pub use rays::{RAYS_PER_PI, RAYS_PER_PI_SQUARE, SourceRays};
 use seen::RayHits;
+pub use windows::ONE_WINDOW_RECTANGLES;
 use windows::{StepWindows, Window};
 
 use super::elementary::ElementaryGrid;

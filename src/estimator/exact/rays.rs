@@ -24,6 +24,12 @@ use crate::stats::angular_span;
 /// (`tests/model.rs` checks against Monte Carlo) at a third of the cost of 384.
 pub const RAYS_PER_PI_SQUARE: f64 = 128.0;
 
+/// Crossings of the ray index allowed per lattice cell (about 100 bytes a
+/// cell): past it and [`MIN_INDEX_CROSSINGS`], plans walk the grid instead.
+pub const INDEX_CROSSINGS_PER_CELL: usize = 5;
+/// Crossings the ray index may always have, whatever the lattice.
+pub const MIN_INDEX_CROSSINGS: usize = 1 << 20;
+
 /// Square fields of view (over the `fovs` slots indexed) up to which each
 /// source indexes where its rays cross them ([`SourceRays::index_looks`]):
 /// about 25 rays of 16 bytes each, so a few MB per source at most.
@@ -268,7 +274,9 @@ impl SourceRays {
     pub fn index_crossings(rays: &mut [SourceRays], s: &Scenario, grid: &ElementaryGrid) {
         let (nx, ny) = grid.dims();
         let bound: usize = rays.iter().map(|sr| sr.dirs.len() * (nx + ny)).sum();
-        if bound > (5 * s.cell_count()).max(1 << 20) || nx * ny > u32::MAX as usize {
+        if bound > (INDEX_CROSSINGS_PER_CELL * s.cell_count()).max(MIN_INDEX_CROSSINGS)
+            || nx * ny > u32::MAX as usize
+        {
             return;
         }
         let zone = s.zone_region();

@@ -19,6 +19,12 @@ use crate::scenario::{Cell, Look, Scenario};
 /// on two cores for the paper's eight sources.
 const CLASSES_PER_BUFFER: usize = 4;
 
+/// A grid of at most this many elementary rectangles gets one window over
+/// all of it, and so does the reaches' bounding box when it is at most this
+/// large (or twice the reaches): one window is the fastest to fill. The cost
+/// model predicts with it.
+pub const ONE_WINDOW_RECTANGLES: usize = 1 << 16;
+
 /// Prefix sums over a block of rectangles.
 pub(super) struct BlockSums {
     a0: usize,
@@ -83,14 +89,14 @@ impl StepWindows {
         });
         let total: usize = reach.iter().map(size).sum();
         let (nx, ny) = grid.dims();
-        if nx * ny <= 1 << 16 {
+        if nx * ny <= ONE_WINDOW_RECTANGLES {
             // A small grid: one window over all of it (the fastest to fill).
             Self {
                 blocks: vec![(0, nx, 0, ny)],
                 built: vec![OnceLock::new()],
                 slot: vec![0; reach.len()],
             }
-        } else if !reach.is_empty() && size(&bbox) <= (1 << 16).max(2 * total) {
+        } else if !reach.is_empty() && size(&bbox) <= ONE_WINDOW_RECTANGLES.max(2 * total) {
             Self {
                 blocks: vec![bbox],
                 built: vec![OnceLock::new()],

@@ -1,0 +1,64 @@
+//! Every limit and default of the API, in one place.
+//!
+//! The code that checks a value, the cost model, the command line and the
+//! OpenAPI document (its bounds are written from these constants, see
+//! `http::openapi`) all read them from here, so one edit changes the limit
+//! everywhere. This module imports nothing: any module may use it.
+
+// The model (a scenario).
+
+/// Largest planning horizon `T` accepted.
+pub const MAX_HORIZON: usize = 12;
+/// Horizon used when a spec does not give one.
+pub const DEFAULT_HORIZON: usize = 3;
+/// Largest number of cells in a lattice.
+pub const MAX_CELLS: usize = 4_000_000;
+/// Largest number of sources in a scenario.
+pub const MAX_SOURCES: usize = 64;
+/// Most speed classes of one source.
+pub const MAX_SPEED_CLASSES: usize = 8;
+/// Largest bound on the zone's population accepted: `Σ rate·diagonal/speed`
+/// over the target classes (the most targets the zone could hold at once if
+/// every one crossed its full diagonal). Keeps every statistic finite.
+pub const MAX_POPULATION: f64 = 1e9;
+/// Most per-cell statistics of a scenario whose sensor types have several
+/// fields of view: cells × distinct fields of view (each field of view has
+/// its own statistics of every cell).
+pub const MAX_CELL_STATS: usize = 8_000_000;
+/// Longest scenario name, characters.
+pub const MAX_NAME_CHARS: usize = 200;
+
+// A fleet.
+
+/// Most named sensor types of a scenario (besides `default`).
+pub const MAX_SENSOR_TYPES: usize = 8;
+/// Fastest sensor, cells (king moves) per step. The search's motion tables
+/// are built for every speed up to it.
+pub const MAX_SENSOR_SPEED: usize = 3;
+/// Most no-go rectangles of a scenario.
+pub const MAX_NO_GO: usize = 256;
+/// Largest minimum separation accepted, cells.
+pub const MAX_MIN_SEPARATION: usize = 16;
+
+// A plan request.
+
+/// Most sensors in one request.
+pub const MAX_SENSORS: usize = 256;
+/// Most targets in one request.
+pub const MAX_TARGETS: usize = 20_000;
+/// Most steps of history.
+pub const MAX_HISTORY_STEPS: usize = 32;
+/// Most positions in one history step.
+pub const MAX_HISTORY_POSITIONS: usize = 256;
+/// Steps of history a session keeps by default.
+pub const DEFAULT_HISTORY_STEPS: usize = 16;
+/// The certified gap `joint` coordination stops at by default.
+pub const DEFAULT_GAP_TARGET: f64 = 0.001;
+/// The time `joint` coordination may take by default, milliseconds.
+pub const DEFAULT_BUDGET_MS: u64 = 20;
+/// The most time `joint` coordination may be given, milliseconds.
+pub const MAX_BUDGET_MS: u64 = 1000;
+/// Largest request body accepted, bytes. Large enough for a plan request
+/// with the most targets allowed ([`MAX_TARGETS`]) written at full
+/// precision.
+pub const MAX_BODY_BYTES: usize = 4 * 1024 * 1024;
