@@ -24,10 +24,9 @@ use rand::{RngExt, SeedableRng};
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use super::MAX_ROUNDS;
 use super::certificate::{Bound, Certifier};
 use super::fleet::{Fleet, SensorPlan, path_slices};
-use super::rounds::best_responses;
+use super::rounds::{MAX_ROUNDS, best_responses};
 use crate::cancel::Cancelled;
 use crate::limits::{DEFAULT_BUDGET_MS, DEFAULT_GAP_TARGET};
 use crate::separation;

@@ -69,6 +69,7 @@ use certificate::Certifier;
 pub use fleet::{Fleet, SensorPlan, path_moves, sensor_motion};
 use fleet::{path_slices, search};
 pub use joint::{JointReport, JointSettings};
+pub use rounds::MAX_ROUNDS;
 
 /// How sensors' searches are coordinated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema)]
@@ -85,9 +86,6 @@ pub enum Coordination {
     /// or the time budget runs out.
     Joint,
 }
-
-/// Largest number of best-response rounds in `Iterated`.
-pub const MAX_ROUNDS: usize = 10;
 
 /// Largest number of repair rounds of the separation.
 pub const MAX_REPAIRS: usize = 8;

@@ -9,6 +9,10 @@ use super::fleet::{Fleet, SensorPlan, path_moves, path_slices};
 use crate::cancel::Cancelled;
 use crate::scenario::Cell;
 
+/// Largest number of best-response rounds in `Iterated` (and in each of
+/// `Joint`'s restarts).
+pub const MAX_ROUNDS: usize = 10;
+
 /// What [`best_responses`] did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Rounds {

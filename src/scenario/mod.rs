@@ -13,11 +13,11 @@ use utoipa::ToSchema;
 
 use crate::geometry::{Disk, Point, Rect, Region};
 use crate::limits::{
-    DEFAULT_HORIZON, MAX_CELL_STATS, MAX_CELLS, MAX_HORIZON, MAX_MIN_SEPARATION, MAX_NAME_CHARS,
-    MAX_POPULATION, MAX_SOURCES,
+    DEFAULT_HORIZON, MAX_CELL_STATS, MAX_CELLS, MAX_NAME_CHARS, MAX_POPULATION, MAX_SOURCES,
 };
 
 mod builtins;
+mod input;
 mod sensor;
 mod source;
 
@@ -26,29 +26,9 @@ pub use builtins::{
     site_fleet_spec, site_gates_spec, site_robot,
 };
 
-pub use sensor::{DEFAULT_TYPE, Look, NoGoSpec, SensorType, SensorTypeSpec, all_certain};
+pub use input::{Integer, ValidationError, check_horizon, check_min_separation};
+pub use sensor::{DEFAULT_TYPE, FovSpec, Look, NoGoSpec, SensorType, SensorTypeSpec, all_certain};
 pub use source::{Heading, Source, SourceSpec, SpeedSpec, TargetClass, infer_heading};
-
-/// An input value outside its bounds. `field` is a JSON path into the
-/// request, `message` says the bound.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{field}: {message}")]
-pub struct ValidationError {
-    /// JSON path of the offending field, e.g. `sources[2].rate`.
-    pub field: String,
-    /// The bound it breaks.
-    pub message: String,
-}
-
-impl ValidationError {
-    /// A validation error for `field`.
-    pub fn new(field: impl Into<String>, message: impl Into<String>) -> Self {
-        Self {
-            field: field.into(),
-            message: message.into(),
-        }
-    }
-}
 
 /// The surveillance zone `[0,width] × [0,height]`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, ToSchema)]
@@ -61,28 +41,6 @@ pub struct ZoneSpec {
     /// Extent north, zone units.
     #[schema(exclusive_minimum = 0)]
     pub height: f64,
-}
-
-/// Field of view of every sensor, tagged by `shape`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, ToSchema)]
-#[serde(tag = "shape", rename_all = "lowercase", deny_unknown_fields)]
-#[schema(examples(
-    json!({"shape": "square", "half_width": 30.0}),
-    json!({"shape": "circle", "radius": 30.0})
-))]
-pub enum FovSpec {
-    /// The paper's inscribed square, `|dx|, |dy| ≤ half_width`.
-    Square {
-        /// Half the side of the square.
-        #[schema(exclusive_minimum = 0)]
-        half_width: f64,
-    },
-    /// A disk of the given radius (the paper's future work).
-    Circle {
-        /// Radius of the disk.
-        #[schema(exclusive_minimum = 0)]
-        radius: f64,
-    },
 }
 
 /// A scenario as clients send it.
@@ -196,99 +154,6 @@ fn finite_positive(field: &str, v: f64) -> Result<f64, ValidationError> {
             format!("must be finite and > 0, got {v}"),
         ))
     }
-}
-
-/// An integer field as JSON carries it. JSON has one number type, so `4.0`
-/// is the integer 4 (as JSON Schema's `integer` also says); a number with a
-/// fraction, or out of range, is kept as sent and refused by validation with
-/// a 422 that names the field.
-///
-/// Fields of this type say `#[schema(value_type = …)]` with an integer type,
-/// so the document states `integer` and the field's bounds.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(transparent)]
-pub struct Integer(serde_json::Number);
-
-impl Integer {
-    /// The value, when it is a whole number in `0..=u64::MAX`.
-    pub fn get(&self) -> Option<u64> {
-        if let Some(v) = self.0.as_u64() {
-            return Some(v);
-        }
-        // 2^64 is exactly representable; every whole f64 below it fits.
-        let v = self.0.as_f64()?;
-        (v.fract() == 0.0 && (0.0..18_446_744_073_709_551_616.0).contains(&v)).then_some(v as u64)
-    }
-
-    /// The value, when it is a whole number that fits an `i64`.
-    pub fn signed(&self) -> Option<i64> {
-        if let Some(v) = self.0.as_i64() {
-            return Some(v);
-        }
-        let v = self.0.as_f64()?;
-        (v.fract() == 0.0
-            && (-9_223_372_036_854_775_808.0..9_223_372_036_854_775_808.0).contains(&v))
-        .then_some(v as i64)
-    }
-
-    /// The number as given.
-    pub fn raw(&self) -> &serde_json::Number {
-        &self.0
-    }
-
-    /// The value if it lies in `range`, else a validation error for
-    /// `field` that states the range.
-    pub fn check(
-        &self,
-        field: &str,
-        range: std::ops::RangeInclusive<usize>,
-    ) -> Result<usize, ValidationError> {
-        self.get()
-            .and_then(|v| usize::try_from(v).ok())
-            .filter(|v| range.contains(v))
-            .ok_or_else(|| {
-                ValidationError::new(
-                    field,
-                    format!(
-                        "must be an integer in {}..={}, got {}",
-                        range.start(),
-                        range.end(),
-                        self.0
-                    ),
-                )
-            })
-    }
-}
-
-impl From<usize> for Integer {
-    fn from(v: usize) -> Self {
-        Integer(serde_json::Number::from(v as u64))
-    }
-}
-
-impl std::fmt::Display for Integer {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        self.0.fmt(f)
-    }
-}
-
-/// Checks a horizon against `1..=MAX_HORIZON`; `None` is `default`.
-pub fn check_horizon(
-    field: &str,
-    h: Option<&Integer>,
-    default: usize,
-) -> Result<usize, ValidationError> {
-    h.map_or(Ok(default), |h| h.check(field, 1..=MAX_HORIZON))
-}
-
-/// Checks a minimum separation against
-/// `0..=`[`MAX_MIN_SEPARATION`]; `None` stays `None`.
-pub fn check_min_separation(
-    field: &str,
-    d: Option<&Integer>,
-) -> Result<Option<usize>, ValidationError> {
-    d.map(|d| d.check(field, 0..=MAX_MIN_SEPARATION))
-        .transpose()
 }
 
 impl Scenario {

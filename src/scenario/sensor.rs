@@ -12,12 +12,34 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use super::{FovSpec, Integer, ValidationError};
+use super::input::{Integer, ValidationError};
 use crate::geometry::Region;
 use crate::limits::{MAX_NO_GO, MAX_SENSOR_SPEED, MAX_SENSOR_TYPES};
 
 /// Name of the type made of the scenario's top-level `fov`.
 pub const DEFAULT_TYPE: &str = "default";
+
+/// Field of view of every sensor, tagged by `shape`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, ToSchema)]
+#[serde(tag = "shape", rename_all = "lowercase", deny_unknown_fields)]
+#[schema(examples(
+    json!({"shape": "square", "half_width": 30.0}),
+    json!({"shape": "circle", "radius": 30.0})
+))]
+pub enum FovSpec {
+    /// The paper's inscribed square, `|dx|, |dy| ≤ half_width`.
+    Square {
+        /// Half the side of the square.
+        #[schema(exclusive_minimum = 0)]
+        half_width: f64,
+    },
+    /// A disk of the given radius (the paper's future work).
+    Circle {
+        /// Radius of the disk.
+        #[schema(exclusive_minimum = 0)]
+        radius: f64,
+    },
+}
 
 /// A sensor type as clients send it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]

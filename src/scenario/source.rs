@@ -12,7 +12,7 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use super::ValidationError;
+use super::input::ValidationError;
 use crate::geometry::{Point, Rect};
 use crate::limits::MAX_SPEED_CLASSES;
 

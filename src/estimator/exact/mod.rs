@@ -7,17 +7,19 @@
 
 mod rays;
 mod seen;
+#[cfg(test)]
+mod tests;
 mod windows;
 
 use rayon::prelude::*;
 
+use rays::{ClassRays, LookKey, look_key};
 pub use rays::{
     INDEX_CROSSINGS_PER_CELL, MIN_INDEX_CROSSINGS, RAYS_PER_PI, RAYS_PER_PI_SQUARE, SourceRays,
 };
-use rays::{LookKey, look_key};
 use seen::RayHits;
 pub use windows::ONE_WINDOW_RECTANGLES;
-use windows::{StepWindows, Window};
+use windows::{SeenRays, StepWindows, Window};
 
 use super::elementary::ElementaryGrid;
 use super::{Elements, Estimator, Target};
@@ -92,6 +94,16 @@ pub struct ExactEstimator<'a> {
 }
 
 impl<'a> ExactEstimator<'a> {
+    /// What the sensors saw along the classes' rays, which windows are
+    /// filled from.
+    fn seen_rays(&self) -> SeenRays<'_> {
+        SeenRays {
+            rays: self.rays,
+            classes: &self.classes,
+            seen: &self.seen,
+        }
+    }
+
     /// Prepares the estimator for sensors of types `types` starting at
     /// `starts` and paths of up to `horizon` steps. `stats` are the
     /// scenario's statistics per field of view (its `fovs`), `observed[s]`
@@ -169,7 +181,7 @@ impl<'a> ExactEstimator<'a> {
     /// first use).
     pub fn prepare(&self) {
         let Some(grid) = self.grid else { return };
-        if let Some(windows) = self.whole_windows(grid) {
+        if let Some(windows) = self.seen_rays().whole_windows(grid, &self.windows) {
             for (step, win) in self.windows.iter().zip(windows) {
                 // A window already built on first use keeps its (equal)
                 // values.
@@ -187,7 +199,8 @@ impl<'a> ExactEstimator<'a> {
             .with_min_len(crate::parallel::min_len())
             .for_each(|&(t, slot)| {
                 let step = &self.windows[t];
-                step.built[slot].get_or_init(|| self.window(grid, step.blocks[slot], t + 1));
+                step.built[slot]
+                    .get_or_init(|| self.seen_rays().window(grid, step.blocks[slot], t + 1));
             });
     }
 
@@ -196,7 +209,8 @@ impl<'a> ExactEstimator<'a> {
         let grid = self.grid?;
         let step = self.windows.get(t.checked_sub(1)?)?;
         let slot = *step.slot.get(sensor)?;
-        let win = step.built[slot].get_or_init(|| self.window(grid, step.blocks[slot], t));
+        let win =
+            step.built[slot].get_or_init(|| self.seen_rays().window(grid, step.blocks[slot], t));
         Some((grid, win))
     }
 
@@ -346,17 +360,6 @@ impl<'a> ExactEstimator<'a> {
     }
 }
 
-/// A target class on its source's rays.
-struct ClassRays {
-    /// Index of the source's rays.
-    rays: usize,
-    /// The class's speed.
-    speed: f64,
-    /// `λ_c/(spread·v_c)` times the angular step: targets per unit of ray
-    /// length, per ray.
-    weight: f64,
-}
-
 /// The probability that every look of `looks` that holds `p` misses a
 /// target there: 1 when none holds it, 0 when a certain one does.
 #[inline]
@@ -371,19 +374,6 @@ fn miss_all(looks: &[&Look], p: Point) -> f64 {
         }
     }
     miss
-}
-
-/// The smaller of two numbers that are not NaN (one `minsd`: `f64::min`
-/// also handles NaN, at three instructions, in the hottest loops).
-#[inline(always)]
-fn min(a: f64, b: f64) -> f64 {
-    if a < b { a } else { b }
-}
-
-/// The larger of two numbers that are not NaN.
-#[inline(always)]
-fn max(a: f64, b: f64) -> f64 {
-    if a > b { a } else { b }
 }
 
 impl Estimator for ExactEstimator<'_> {
@@ -404,7 +394,7 @@ impl Estimator for ExactEstimator<'_> {
         };
         let near: Vec<Look> = near.into_iter().copied().collect();
         let block = grid.span(ty.fov_slot, k);
-        let unseen = self.block_sums(grid, win, block, &near).sum(block);
+        let unseen = win.block_sums(grid, block, &near).sum(block);
         ty.p_detect * (known + unseen)
     }
 
@@ -440,7 +430,7 @@ impl Estimator for ExactEstimator<'_> {
                 row: (start.row + ti).min(s.rows - 1),
             },
         );
-        let sums = self.block_sums(grid, win, (lo, hi, blo, bhi), excluded);
+        let sums = win.block_sums(grid, (lo, hi, blo, bhi), excluded);
         // Known targets at step t, each with the chance that every excluded
         // look misses it: those no look holds are counted (an integer count
         // is the hot loop's cheapest form), the others summed by weight.

@@ -4,7 +4,6 @@
 
 use rayon::prelude::*;
 
-use super::{max, min};
 use crate::estimator::elementary::{ElementaryGrid, trace};
 use crate::geometry::{Point, Rect, Region};
 use crate::scenario::{Cell, FovSpec, Scenario, Source};
@@ -476,6 +475,30 @@ fn approx_atan2(y: f64, x: f64) -> f64 {
         r = PI - r;
     }
     if y < 0.0 { -r } else { r }
+}
+
+/// A target class on its source's rays.
+pub(super) struct ClassRays {
+    /// Index of the source's rays.
+    pub rays: usize,
+    /// The class's speed.
+    pub speed: f64,
+    /// `λ_c/(spread·v_c)` times the angular step: targets per unit of ray
+    /// length, per ray.
+    pub weight: f64,
+}
+
+/// The smaller of two numbers that are not NaN (one `minsd`: `f64::min`
+/// also handles NaN, at three instructions, in the hottest loops).
+#[inline(always)]
+pub(super) fn min(a: f64, b: f64) -> f64 {
+    if a < b { a } else { b }
+}
+
+/// The larger of two numbers that are not NaN.
+#[inline(always)]
+pub(super) fn max(a: f64, b: f64) -> f64 {
+    if a > b { a } else { b }
 }
 
 #[cfg(test)]

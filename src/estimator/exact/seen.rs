@@ -8,8 +8,7 @@
 //! held the piece that a target there was detected: a target that stayed
 //! unreported is still in the zone with the rest of that probability.
 
-use super::rays::{LookKey, SourceRays, slab};
-use super::{max, min};
+use super::rays::{LookKey, SourceRays, max, min, slab};
 use crate::geometry::detection_pieces;
 use crate::scenario::{Look, all_certain};
 
@@ -30,8 +29,8 @@ use crate::scenario::{Look, all_certain};
 /// ([`LookCrossings::past_exit`](super::rays::LookCrossings::past_exit)).
 pub(super) struct RayHits {
     /// `hits[offsets[m]..offsets[m+1]]` are ray `m`'s intervals.
-    offsets: Vec<u32>,
-    hits: Vec<(f64, f64)>,
+    pub(super) offsets: Vec<u32>,
+    pub(super) hits: Vec<(f64, f64)>,
     /// Aligned with `hits`: the detection probability of each interval.
     /// Empty when every look is certain (every interval's is 1).
     detected: Vec<f64>,
@@ -314,207 +313,5 @@ fn extend(cur: &mut (f64, f64), m: u32, p: f64, q: f64, pieces: &mut Vec<(u32, f
     } else {
         flush(cur, m, pieces);
         *cur = (p, q);
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::super::ExactEstimator;
-    use super::super::rays::{SourceRays, look_key};
-    use super::RayHits;
-    use crate::estimator::Estimator;
-    use crate::estimator::elementary::ElementaryGrid;
-    use crate::scenario::{Cell, FovSpec, Look, Scenario, builtins, site_fleet_spec};
-    use crate::stats::Stats;
-
-    /// Leaving out the seen intervals that start past a ray's exit from the
-    /// zone (and skipping the looks whose every interval does) changes no
-    /// value, to the bit: every built-in (`site-fleet`'s
-    /// uncertain looks too), a long history that pushes many intervals out,
-    /// by the windows and by the rays, with and without excluded looks.
-    #[test]
-    fn intervals_past_the_exit_change_no_value() {
-        let (mut dropped, mut skipped) = (0, 0);
-        for s in builtins() {
-            let stats: Vec<Stats> = s.fovs.iter().map(|&f| Stats::for_fov(&s, f)).collect();
-            let grid = ElementaryGrid::new(&s).expect("squares");
-            let mut rays = SourceRays::for_scenario(&s);
-            SourceRays::index_crossings(&mut rays, &s, &grid);
-            SourceRays::index_looks(&mut rays, &s);
-            let mut kept = rays.clone();
-            kept.iter_mut().for_each(SourceRays::keep_past_the_exit);
-            let (cols, rows) = (s.cols, s.rows);
-            let starts: Vec<Cell> = (0..6)
-                .map(|i: i32| Cell {
-                    col: (i * 7 + 2).rem_euclid(cols),
-                    row: (i * 11 + 3).rem_euclid(rows),
-                })
-                .filter(|&c| s.is_free(c))
-                .collect();
-            let types: Vec<usize> = (0..starts.len()).map(|i| i % s.types.len()).collect();
-            let observed: Vec<Vec<Look>> = (0..24)
-                .map(|step: i32| {
-                    starts
-                        .iter()
-                        .zip(&types)
-                        .map(|(c, &ty)| {
-                            let c = Cell {
-                                col: (c.col + step % 5 - 2).clamp(0, cols - 1),
-                                row: (c.row + step % 3 - 1).clamp(0, rows - 1),
-                            };
-                            s.look(ty, c)
-                        })
-                        .collect()
-                })
-                .collect();
-            let horizon = 3;
-            let build = |rays| {
-                let est = ExactEstimator::new(
-                    &s,
-                    &stats,
-                    rays,
-                    Some(&grid),
-                    &observed,
-                    &[],
-                    &starts,
-                    &types,
-                    horizon,
-                );
-                est.prepare();
-                est
-            };
-            let (est, all) = (build(&rays), build(&kept));
-            for (a, b) in est.seen.iter().zip(&all.seen) {
-                dropped += b.hits.len() - a.hits.len();
-            }
-            // Whole looks are skipped too, without reading their rays.
-            for (sr, table) in rays.iter().filter_map(|sr| Some((sr, sr.looks.as_ref()?))) {
-                for class in s.classes_of(sr.source_index) {
-                    for (step, looks) in observed.iter().enumerate() {
-                        let shift = class.speed * step as f64;
-                        skipped += looks
-                            .iter()
-                            .filter_map(|l| look_key(&s, &l.region))
-                            .filter(|&key| table.past_exit(key, shift))
-                            .count();
-                    }
-                }
-            }
-            for i in 0..starts.len() {
-                let other = (i + 1) % starts.len();
-                let excluded = [s.look(types[other], starts[other])];
-                for t in 1..=horizon {
-                    for k in (0..s.cell_count()).step_by(7).map(|k| s.cell_at(k)) {
-                        for x in [&[][..], &excluded[..]] {
-                            let pair = [
-                                (est.value(i, k, t, x), all.value(i, k, t, x)),
-                                (est.value_by_rays(i, k, t, x), all.value_by_rays(i, k, t, x)),
-                            ];
-                            for (a, b) in pair {
-                                assert_eq!(a.to_bits(), b.to_bits(), "{} {k:?} t={t}", s.id);
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        assert!(dropped > 100, "{dropped}");
-        assert!(skipped > 100, "{skipped}");
-    }
-
-    /// The seen sets built from indexed looks are the computed ones, to the
-    /// bit: looks of every field of view (two sizes in `site-fleet`) at
-    /// cells all over the lattice, its corners included, a whole-zone look
-    /// (never indexed), every class's speed.
-    #[test]
-    fn indexed_looks_give_the_computed_seen_sets() {
-        // site-fleet's types detect with 0.9 and 0.6: its seen sets never
-        // read the index, which it therefore does not build. Made certain,
-        // it has two sizes of field of view.
-        let mut certain_fleet = site_fleet_spec();
-        for ty in certain_fleet
-            .sensor_types
-            .iter_mut()
-            .flat_map(|t| t.values_mut())
-        {
-            ty.p_detect = Some(1.0);
-        }
-        certain_fleet.p_detect = Some(1.0);
-        let mut scenarios = builtins();
-        let uncertain = scenarios.pop().expect("site-fleet");
-        let mut rays = SourceRays::for_scenario(&uncertain);
-        SourceRays::index_looks(&mut rays, &uncertain);
-        assert!(rays.iter().all(|r| r.looks.is_none()));
-        scenarios.push(Scenario::new(certain_fleet).expect("valid"));
-        let mut compared = 0;
-        for s in scenarios {
-            let mut rays = SourceRays::for_scenario(&s);
-            SourceRays::index_looks(&mut rays, &s);
-            assert!(rays.iter().all(|r| r.looks.is_some()), "{}", s.id);
-            // Every square field of view at every cell has its key.
-            for (slot, fov) in s.fovs.iter().enumerate() {
-                assert!(matches!(fov, FovSpec::Square { .. }));
-                for k in 0..s.cell_count() {
-                    let region = s.fov_with(*fov, s.centre(s.cell_at(k)));
-                    let key = look_key(&s, &region).expect("a key");
-                    // A smaller field of view may equal a larger one
-                    // clipped: then either key holds the same region.
-                    let (ks, kk) = (key as usize / s.cell_count(), key as usize % s.cell_count());
-                    assert_eq!(s.fov_with(s.fovs[ks], s.centre(s.cell_at(kk))), region);
-                    assert!(ks <= slot);
-                }
-            }
-            assert_eq!(look_key(&s, &s.zone_region()), None);
-            let (cols, rows) = (s.cols, s.rows);
-            let observed: Vec<Vec<Look>> = (0..7)
-                .map(|step: i32| {
-                    let mut looks: Vec<Look> = (0..9)
-                        .map(|i: i32| {
-                            let c = Cell {
-                                col: (i * 7 + step * 3).rem_euclid(cols),
-                                row: (i * 5 + step * 2).rem_euclid(rows),
-                            };
-                            let fov = s.fovs[i as usize % s.fovs.len()];
-                            Look::certain(s.fov_with(fov, s.centre(c)))
-                        })
-                        .collect();
-                    looks.push(Look::certain(
-                        s.fov_with(s.fovs[0], s.centre(Cell { col: 0, row: 0 })),
-                    ));
-                    let far = Cell {
-                        col: cols - 1,
-                        row: rows - 1,
-                    };
-                    looks.push(Look::certain(
-                        s.fov_with(*s.fovs.last().expect("a fov"), s.centre(far)),
-                    ));
-                    if step == 3 {
-                        looks.push(Look::certain(s.zone_region()));
-                    }
-                    looks
-                })
-                .collect();
-            let keys: Vec<Vec<_>> = observed
-                .iter()
-                .map(|step| step.iter().map(|l| look_key(&s, &l.region)).collect())
-                .collect();
-            assert!(keys.iter().flatten().filter(|k| k.is_some()).count() >= 7 * 11);
-            for sr in &rays {
-                for class in s.classes_of(sr.source_index) {
-                    let read = RayHits::new(sr, &observed, &keys, class.speed);
-                    let computed = RayHits::new(sr, &observed, &[], class.speed);
-                    assert_eq!(read.offsets, computed.offsets);
-                    let bits = |h: &RayHits| -> Vec<(u64, u64)> {
-                        h.hits
-                            .iter()
-                            .map(|&(p, q)| (p.to_bits(), q.to_bits()))
-                            .collect()
-                    };
-                    assert_eq!(bits(&read), bits(&computed), "{}", s.id);
-                    compared += read.hits.len();
-                }
-            }
-        }
-        assert!(compared > 2_000, "{compared}");
     }
 }

@@ -6,9 +6,8 @@ use std::sync::OnceLock;
 
 use rayon::prelude::*;
 
-use super::rays::{Crossings, SourceRays};
+use super::rays::{ClassRays, Crossings, SourceRays, max, min};
 use super::seen::RayHits;
-use super::{ExactEstimator, max, min};
 use crate::estimator::elementary::{Block, ElementaryGrid, trace};
 use crate::geometry::{Point, Region};
 use crate::scenario::{Cell, Look, Scenario};
@@ -127,9 +126,69 @@ impl Window {
     pub(super) fn row(&self, b: usize) -> &[f64] {
         &self.unseen[b * self.na..(b + 1) * self.na]
     }
+
+    /// Prefix sums of the unseen mass over `block` (global indices, inside
+    /// the window), each rectangle times the probability that every
+    /// excluded look misses it (fields of view are unions of rectangles:
+    /// those whose centre they contain); a certain look leaves it out.
+    pub(super) fn block_sums(
+        &self,
+        grid: &ElementaryGrid,
+        block: Block,
+        excluded: &[Look],
+    ) -> BlockSums {
+        let (a0, a1, b0, b1) = block;
+        let w = a1 - a0 + 1;
+        let mut prefix = vec![0.0; w * (b1 - b0 + 1)];
+        let xc: Vec<f64> = (a0..a1)
+            .map(|a| 0.5 * (grid.xs[a] + grid.xs[a + 1]))
+            .collect();
+        // The excluded looks across each row, in their order (one buffer).
+        let mut rows: Vec<&Look> = Vec::with_capacity(excluded.len());
+        for (j, b) in (b0..b1).enumerate() {
+            let yc = 0.5 * (grid.ys[b] + grid.ys[b + 1]);
+            rows.clear();
+            rows.extend(
+                excluded
+                    .iter()
+                    .filter(|x| yc >= x.region.rect.y0 && yc <= x.region.rect.y1),
+            );
+            let mut row = 0.0;
+            for (i, a) in (a0..a1).enumerate() {
+                let mut miss = 1.0;
+                for x in &rows {
+                    if xc[i] >= x.region.rect.x0 && xc[i] <= x.region.rect.x1 {
+                        miss *= x.miss();
+                        if miss == 0.0 {
+                            break;
+                        }
+                    }
+                }
+                if miss == 1.0 {
+                    row += self.unseen[(b - self.b0) * self.na + (a - self.a0)];
+                } else if miss > 0.0 {
+                    row += miss * self.unseen[(b - self.b0) * self.na + (a - self.a0)];
+                }
+                prefix[(j + 1) * w + i + 1] = prefix[j * w + i + 1] + row;
+            }
+        }
+        BlockSums { a0, b0, w, prefix }
+    }
 }
 
-impl ExactEstimator<'_> {
+/// What the sensors saw, along each target class's rays: the part of the
+/// exact estimator a window is filled from.
+pub(super) struct SeenRays<'a> {
+    /// The sources' rays.
+    pub rays: &'a [SourceRays],
+    /// The target classes, each on its source's rays.
+    pub classes: &'a [ClassRays],
+    /// Per class (aligned with `classes`), where its rays crossed what was
+    /// seen.
+    pub seen: &'a [RayHits],
+}
+
+impl SeenRays<'_> {
     /// The unseen mass at step `t` of the elementary rectangles of a block.
     pub(super) fn window(
         &self,
@@ -194,14 +253,18 @@ impl ExactEstimator<'_> {
     /// the steps, and the crossing where a ray's first interval starts is
     /// found from the previous step's (a lift later) instead of by a new
     /// bisection. Each window gets the same sums in the same order as
-    /// [`ExactEstimator::window`] would give it: the same values to the
+    /// [`SeenRays::window`] would give it: the same values to the
     /// last bit. `None` when the steps' windows are not all the whole grid
     /// or a ray index is missing.
-    pub(super) fn whole_windows(&self, grid: &ElementaryGrid) -> Option<Vec<Window>> {
+    pub(super) fn whole_windows(
+        &self,
+        grid: &ElementaryGrid,
+        windows: &[StepWindows],
+    ) -> Option<Vec<Window>> {
         let (nx, ny) = grid.dims();
         let whole = (0, nx, 0, ny);
-        if self.windows.is_empty()
-            || !self.windows.iter().all(|w| w.blocks == [whole])
+        if windows.is_empty()
+            || !windows.iter().all(|w| w.blocks == [whole])
             || self
                 .classes
                 .iter()
@@ -209,7 +272,7 @@ impl ExactEstimator<'_> {
         {
             return None;
         }
-        let steps = self.windows.len();
+        let steps = windows.len();
         let per_group: Vec<Vec<Vec<f64>>> = self
             .classes
             .par_chunks(CLASSES_PER_BUFFER)
@@ -345,55 +408,6 @@ impl ExactEstimator<'_> {
                 }
             }
         }
-    }
-
-    /// Prefix sums of the unseen mass over `block` (global indices, inside
-    /// the window), each rectangle times the probability that every
-    /// excluded look misses it (fields of view are unions of rectangles:
-    /// those whose centre they contain); a certain look leaves it out.
-    pub(super) fn block_sums(
-        &self,
-        grid: &ElementaryGrid,
-        win: &Window,
-        block: Block,
-        excluded: &[Look],
-    ) -> BlockSums {
-        let (a0, a1, b0, b1) = block;
-        let w = a1 - a0 + 1;
-        let mut prefix = vec![0.0; w * (b1 - b0 + 1)];
-        let xc: Vec<f64> = (a0..a1)
-            .map(|a| 0.5 * (grid.xs[a] + grid.xs[a + 1]))
-            .collect();
-        // The excluded looks across each row, in their order (one buffer).
-        let mut rows: Vec<&Look> = Vec::with_capacity(excluded.len());
-        for (j, b) in (b0..b1).enumerate() {
-            let yc = 0.5 * (grid.ys[b] + grid.ys[b + 1]);
-            rows.clear();
-            rows.extend(
-                excluded
-                    .iter()
-                    .filter(|x| yc >= x.region.rect.y0 && yc <= x.region.rect.y1),
-            );
-            let mut row = 0.0;
-            for (i, a) in (a0..a1).enumerate() {
-                let mut miss = 1.0;
-                for x in &rows {
-                    if xc[i] >= x.region.rect.x0 && xc[i] <= x.region.rect.x1 {
-                        miss *= x.miss();
-                        if miss == 0.0 {
-                            break;
-                        }
-                    }
-                }
-                if miss == 1.0 {
-                    row += win.unseen[(b - win.b0) * win.na + (a - win.a0)];
-                } else if miss > 0.0 {
-                    row += miss * win.unseen[(b - win.b0) * win.na + (a - win.a0)];
-                }
-                prefix[(j + 1) * w + i + 1] = prefix[j * w + i + 1] + row;
-            }
-        }
-        BlockSums { a0, b0, w, prefix }
     }
 }
 
