@@ -22,6 +22,7 @@
 //! registered scenarios on disk.
 
 pub mod cancel;
+pub mod catalog;
 pub mod coordination;
 pub mod cost;
 pub mod estimator;

@@ -14,8 +14,9 @@ use axum::http::StatusCode;
 use axum::routing::{delete, post};
 use bytes::Bytes;
 use tokio::net::TcpListener;
+use vigil::catalog::Registry;
 use vigil::http::config::Settings;
-use vigil::http::{AppState, Registry, router};
+use vigil::http::{AppState, router};
 use vigil_loadtest::generator::{RunConfig, SessionTarget, Summary, Target, run};
 use vigil_loadtest::schedule::Arrivals;
 

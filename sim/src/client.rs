@@ -207,7 +207,7 @@ pub async fn spawn_local_server_with(
     settings: vigil::http::config::Settings,
 ) -> std::io::Result<String> {
     let state = tokio::task::spawn_blocking(move || {
-        vigil::http::AppState::with_settings(vigil::http::Registry::with_builtins(), settings)
+        vigil::http::AppState::with_settings(vigil::catalog::Registry::with_builtins(), settings)
     })
     .await
     .map_err(std::io::Error::other)?;

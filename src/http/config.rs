@@ -5,6 +5,8 @@ use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::time::Duration;
 
+use crate::catalog::JobLimits;
+
 /// Log output format.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum LogFormat {
@@ -174,8 +176,8 @@ impl Settings {
     }
 
     /// The registry's bounds on precomputation.
-    pub fn job_limits(&self) -> super::JobLimits {
-        super::JobLimits {
+    pub fn job_limits(&self) -> JobLimits {
+        JobLimits {
             sync_precompute_ms: self.sync_precompute_ms,
             jobs: self.precompute_jobs,
             queue: self.precompute_queue,

@@ -8,6 +8,7 @@ use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
+use crate::catalog::{CatalogError, JobStatus};
 use crate::scenario::ValidationError;
 
 /// Seconds a client should wait after [`ApiError::DatabaseUnavailable`].
@@ -94,7 +95,7 @@ pub enum ApiError {
         /// The scenario's id.
         id: String,
         /// Its job's status.
-        status: super::registry::JobStatus,
+        status: JobStatus,
     },
     /// The precomputation queue is full. 503 with Retry-After.
     #[error("{limit} precomputation jobs are already waiting; retry in about {retry_after_s} s")]
@@ -318,5 +319,24 @@ impl From<PathRejection> for ApiError {
 impl From<tokio::task::JoinError> for ApiError {
     fn from(e: tokio::task::JoinError) -> Self {
         ApiError::Internal(format!("background task failed: {e}"))
+    }
+}
+
+impl From<CatalogError> for ApiError {
+    fn from(e: CatalogError) -> Self {
+        match e {
+            CatalogError::NotFound(id) => ApiError::ScenarioNotFound(id),
+            CatalogError::NotReady { id, status } => ApiError::ScenarioNotReady { id, status },
+            CatalogError::Builtin(id) => ApiError::BuiltinScenario(id),
+            CatalogError::QueueFull {
+                limit,
+                retry_after_s,
+            } => ApiError::QueueFull {
+                limit,
+                retry_after_s,
+            },
+            CatalogError::Internal(message) => ApiError::Internal(message),
+            CatalogError::DatabaseUnavailable => ApiError::DatabaseUnavailable,
+        }
     }
 }

@@ -56,7 +56,6 @@ macro_rules! path_rules {
     };
 }
 
-pub mod cache;
 pub mod config;
 pub mod error;
 pub mod evaluate;
@@ -65,7 +64,6 @@ pub mod health;
 pub mod middleware;
 pub mod openapi;
 pub mod plan;
-pub mod registry;
 pub mod scenarios;
 pub mod serve;
 pub mod sessions;
@@ -85,13 +83,12 @@ use tower_http::request_id::{MakeRequestUuid, PropagateRequestIdLayer, SetReques
 use tower_http::trace::{DefaultOnFailure, TraceLayer};
 use tracing::Level;
 
-use self::cache::PlannerCache;
 use self::config::{Config, Settings};
+use crate::catalog::{PlannerCache, Registry};
 use crate::limits::MAX_BODY_BYTES;
 use crate::store::{PgStore, Store};
 
 pub use error::{ApiError, Problem};
-pub use registry::{JobLimits, Registry, precompute};
 
 /// Pieces of work that may wait for a rayon worker, per worker; past that,
 /// more are shed at once with 503. Eight plans of the reference workload

@@ -16,8 +16,8 @@ use utoipa::openapi::{Ref, RefOr};
 use utoipa::{Modify, OpenApi, ToResponse, ToSchema};
 
 use super::error::{ApiError, Problem};
-use super::registry::JobStatus;
 use super::{evaluate, health, middleware, plan, scenarios, sessions};
+use crate::catalog::JobStatus;
 use crate::coordination::Coordination;
 use crate::evaluate::SensorPathIn;
 use crate::limits::{MAX_HISTORY_POSITIONS, MAX_SENSOR_TYPES};

@@ -13,8 +13,8 @@ use super::extract::{Json, Path, QueuedJson};
 use super::middleware::RequestStart;
 use super::openapi::{self as doc, examples};
 
-use super::registry::{precompute_cancellable, predicted_precompute_ms};
 use crate::cancel::{CancelToken, Progress};
+use crate::catalog::{CatalogError, precompute_cancellable, predicted_precompute_ms};
 use crate::cost;
 use crate::planner::{PlanInput, PlanRequest, PlanResponse, Planner};
 use crate::scenario::{Scenario, ScenarioSpec};
@@ -284,7 +284,7 @@ pub(super) async fn resolve_scenario(
 fn registered_or_cached(state: &AppState, id: &str) -> Result<Option<Arc<Planner>>, ApiError> {
     match state.registry.ready(id) {
         Ok(p) => Ok(Some(p)),
-        Err(ApiError::ScenarioNotFound(_)) => Ok(state.cache.get(id)),
-        Err(e) => Err(e),
+        Err(CatalogError::NotFound(_)) => Ok(state.cache.get(id)),
+        Err(e) => Err(e.into()),
     }
 }

@@ -17,10 +17,10 @@ use super::extract::{Json, Path};
 use super::middleware::RequestStart;
 use super::openapi::{self as doc, examples};
 use super::plan::CancelOnDrop;
-use super::registry::{
+use crate::cancel::Progress;
+use crate::catalog::{
     Entry, JobStatus, Listed, entry_id, precompute_cancellable, predicted_precompute_ms,
 };
-use crate::cancel::Progress;
 use crate::planner::Planner;
 use crate::scenario::{DEFAULT_TYPE, Scenario, ScenarioSpec};
 

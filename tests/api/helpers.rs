@@ -7,9 +7,10 @@ use std::time::{Duration, Instant};
 use reqwest::{Response, StatusCode, header};
 use serde_json::{Value, json};
 use tokio::net::TcpListener;
+use vigil::catalog::Registry;
 use vigil::http::config::Settings;
 use vigil::http::serve::{ConnLimits, serve};
-use vigil::http::{AppState, Registry, router};
+use vigil::http::{AppState, router};
 
 /// A running server and a client for it.
 pub struct TestApp {

@@ -23,184 +23,23 @@
 //!   held ids are checked against the table, so a notification missed
 //!   during an outage never leaves a deleted scenario served. While the
 //!   database is unreachable, what is held keeps serving, and what needs
-//!   the database answers [`ApiError::DatabaseUnavailable`].
+//!   the database answers [`CatalogError::DatabaseUnavailable`].
 
 use std::collections::btree_map::Entry as MapEntry;
 use std::collections::{BTreeMap, HashMap, VecDeque};
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Arc, Mutex, OnceLock, PoisonError, RwLock};
+use std::sync::{Arc, Mutex, PoisonError, RwLock};
 use std::time::{Duration, Instant};
 
 use super::cache::PlannerCache;
-use super::error::ApiError;
-use crate::cancel::{CancelToken, Cancelled, Progress};
-use crate::cost;
+use super::error::CatalogError;
+use super::jobs::{
+    Entry, Job, JobLimits, JobStatus, Pool, entry_id, precompute, precompute_on,
+    predicted_precompute_ms,
+};
 use crate::planner::Planner;
 use crate::scenario::{BUILTIN_IDS, Scenario, builtins};
 use crate::store::{DbError, PgStore, Store};
-
-/// The bounds on precomputation.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct JobLimits {
-    /// A registration predicted to take longer than this (milliseconds,
-    /// wall time on the precompute pool) runs as a job.
-    pub sync_precompute_ms: f64,
-    /// Jobs running at once.
-    pub jobs: usize,
-    /// Jobs waiting at most; past it a registration is refused with 503.
-    pub queue: usize,
-}
-
-impl Default for JobLimits {
-    fn default() -> Self {
-        Self {
-            sync_precompute_ms: 1000.0,
-            jobs: 1,
-            queue: 16,
-        }
-    }
-}
-
-/// Which pool a precomputation runs on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Pool {
-    /// Registrations answered when done (and inline scenarios).
-    Sync,
-    /// Background jobs.
-    Jobs,
-}
-
-/// The precompute pools: threads of their own, so a large scenario's many
-/// tasks do not sit ahead of every plan's on rayon's global pool; they
-/// share the cores through the OS scheduler instead. Jobs have a pool
-/// apart from synchronous registrations: in one pool, a small
-/// registration's work would queue behind every block of a running job.
-fn pool(which: Pool) -> Option<&'static rayon::ThreadPool> {
-    static SYNC: OnceLock<Option<rayon::ThreadPool>> = OnceLock::new();
-    static JOBS: OnceLock<Option<rayon::ThreadPool>> = OnceLock::new();
-    let (cell, name) = match which {
-        Pool::Sync => (&SYNC, "vigil-precompute"),
-        Pool::Jobs => (&JOBS, "vigil-job"),
-    };
-    cell.get_or_init(|| {
-        rayon::ThreadPoolBuilder::new()
-            .thread_name(move |i| format!("{name}-{i}"))
-            .build()
-            .map_err(|e| tracing::warn!(error = %e, "no precompute pool; using the global one"))
-            .ok()
-    })
-    .as_ref()
-}
-
-/// Predicted wall time of precomputing `s` on the precompute pool,
-/// milliseconds: the model's CPU time ([`cost::precompute_ms`]) shared by
-/// the pool's threads (the work splits evenly over blocks of cells).
-pub fn predicted_precompute_ms(s: &Scenario) -> f64 {
-    let threads =
-        pool(Pool::Sync).map_or_else(rayon::current_num_threads, |p| p.current_num_threads());
-    cost::precompute_ms(s) / threads.max(1) as f64
-}
-
-/// Precomputes a scenario's statistics on the precompute pool.
-pub fn precompute(scenario: Scenario) -> Planner {
-    match precompute_cancellable(scenario, &CancelToken::never(), &Progress::default()) {
-        Ok(planner) => planner,
-        Err(Cancelled) => unreachable!("work that is never cancelled finishes"),
-    }
-}
-
-/// [`precompute`], stopping within one block of cells once `cancel` is
-/// cancelled, and advancing `progress` (see [`Planner::precompute`]).
-///
-/// # Errors
-/// [`Cancelled`] once `cancel` is cancelled.
-pub fn precompute_cancellable(
-    scenario: Scenario,
-    cancel: &CancelToken,
-    progress: &Progress,
-) -> Result<Planner, Cancelled> {
-    precompute_on(Pool::Sync, scenario, cancel, progress)
-}
-
-fn precompute_on(
-    which: Pool,
-    scenario: Scenario,
-    cancel: &CancelToken,
-    progress: &Progress,
-) -> Result<Planner, Cancelled> {
-    let planner = match pool(which) {
-        Some(pool) => pool.install(|| Planner::precompute(scenario, cancel, progress)),
-        None => Planner::precompute(scenario, cancel, progress),
-    }?;
-    metrics::histogram!("vigil_precompute_seconds").record(planner.precompute_ms / 1e3);
-    Ok(planner)
-}
-
-/// A scenario being precomputed in the background, or waiting to be.
-#[derive(Debug)]
-pub struct Job {
-    /// The scenario.
-    pub scenario: Scenario,
-    /// Predicted wall time of its precomputation, milliseconds.
-    pub predicted_ms: f64,
-    cancel: CancelToken,
-    progress: Progress,
-    started: OnceLock<Instant>,
-}
-
-impl Job {
-    fn new(scenario: Scenario) -> Self {
-        Self {
-            predicted_ms: predicted_precompute_ms(&scenario),
-            scenario,
-            cancel: CancelToken::new(),
-            progress: Progress::default(),
-            started: OnceLock::new(),
-        }
-    }
-
-    /// Seconds until this running job ends: from its measured rate once a
-    /// few blocks are done, from the prediction before.
-    fn remaining_s(&self) -> f64 {
-        let Some(started) = self.started.get() else {
-            return self.predicted_ms / 1e3;
-        };
-        let elapsed = started.elapsed().as_secs_f64();
-        let done = self.progress.fraction();
-        if done >= 0.02 {
-            elapsed * (1.0 - done) / done
-        } else {
-            (self.predicted_ms / 1e3 - elapsed).max(0.0)
-        }
-    }
-}
-
-/// Where a registered scenario is in its lifecycle.
-#[derive(Debug, Clone)]
-pub enum Entry {
-    /// Precomputed: plans are served.
-    Ready(Arc<Planner>),
-    /// Queued or precomputing.
-    Pending(Arc<Job>),
-}
-
-/// What a pending scenario's status says.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct JobStatus {
-    /// Its place in the queue (1 = next), or `None` while it runs.
-    pub queue_position: Option<usize>,
-    /// Share of its blocks of cells done, 0..1.
-    pub progress: f64,
-    /// Seconds until it is ready, estimated.
-    pub eta_s: f64,
-}
-
-impl JobStatus {
-    /// Seconds a client should wait before asking again (`Retry-After`).
-    pub fn retry_after_s(&self) -> u64 {
-        self.eta_s.ceil().clamp(1.0, 3600.0) as u64
-    }
-}
 
 #[derive(Debug, Default)]
 struct State {
@@ -242,13 +81,6 @@ pub enum Listed {
     Held(Entry, Option<JobStatus>),
     /// In the database, not (yet) used on this replica.
     Stored(Box<Scenario>),
-}
-
-/// The problem for a failed call to the database (logged here; the client
-/// is told only to retry).
-pub fn unavailable(e: DbError) -> ApiError {
-    tracing::warn!(error = %e, "the scenario database is unavailable");
-    ApiError::DatabaseUnavailable
 }
 
 /// True for ids that can name a registered scenario (`s-` and 16 hex
@@ -418,19 +250,22 @@ impl Registry {
     /// The planner of a scenario held here, to plan with.
     ///
     /// # Errors
-    /// [`ApiError::ScenarioNotFound`] for an id not held here,
-    /// [`ApiError::ScenarioNotReady`] while it is pending.
-    pub fn ready(&self, id: &str) -> Result<Arc<Planner>, ApiError> {
+    /// [`CatalogError::NotFound`] for an id not held here,
+    /// [`CatalogError::NotReady`] while it is pending.
+    pub fn ready(&self, id: &str) -> Result<Arc<Planner>, CatalogError> {
         match self.entry(id) {
             Some(found) => Self::planner_of(id, found),
-            None => Err(ApiError::ScenarioNotFound(id.to_owned())),
+            None => Err(CatalogError::NotFound(id.to_owned())),
         }
     }
 
-    fn planner_of(id: &str, found: (Entry, Option<JobStatus>)) -> Result<Arc<Planner>, ApiError> {
+    fn planner_of(
+        id: &str,
+        found: (Entry, Option<JobStatus>),
+    ) -> Result<Arc<Planner>, CatalogError> {
         match found {
             (Entry::Ready(p), _) => Ok(p),
-            (Entry::Pending(job), status) => Err(ApiError::ScenarioNotReady {
+            (Entry::Pending(job), status) => Err(CatalogError::NotReady {
                 id: id.to_owned(),
                 status: status.unwrap_or(JobStatus {
                     queue_position: None,
@@ -459,15 +294,15 @@ impl Registry {
     /// from it and made ready here, or started as a job if large.
     ///
     /// # Errors
-    /// [`ApiError::ScenarioNotFound`] for an unknown id,
-    /// [`ApiError::DatabaseUnavailable`] if it must be read and cannot be.
-    pub async fn lookup(&self, id: &str) -> Result<(Entry, Option<JobStatus>), ApiError> {
+    /// [`CatalogError::NotFound`] for an unknown id,
+    /// [`CatalogError::DatabaseUnavailable`] if it must be read and cannot be.
+    pub async fn lookup(&self, id: &str) -> Result<(Entry, Option<JobStatus>), CatalogError> {
         if let Some(found) = self.entry(id) {
             return Ok(found);
         }
         match &self.shared.db {
             Some(db) if derivable(id) => self.load(db, id).await,
-            _ => Err(ApiError::ScenarioNotFound(id.to_owned())),
+            _ => Err(CatalogError::NotFound(id.to_owned())),
         }
     }
 
@@ -475,16 +310,20 @@ impl Registry {
     /// miss ([`Registry::lookup`]).
     ///
     /// # Errors
-    /// Those of [`Registry::lookup`], and [`ApiError::ScenarioNotReady`]
+    /// Those of [`Registry::lookup`], and [`CatalogError::NotReady`]
     /// while it is pending.
-    pub async fn resolve(&self, id: &str) -> Result<Arc<Planner>, ApiError> {
+    pub async fn resolve(&self, id: &str) -> Result<Arc<Planner>, CatalogError> {
         let found = self.lookup(id).await?;
         Self::planner_of(id, found)
     }
 
     /// Reads `id` from the database and makes it ready here (a large one is
     /// started as a job), one load per id at a time.
-    async fn load(&self, db: &Database, id: &str) -> Result<(Entry, Option<JobStatus>), ApiError> {
+    async fn load(
+        &self,
+        db: &Database,
+        id: &str,
+    ) -> Result<(Entry, Option<JobStatus>), CatalogError> {
         let lock = db
             .loading
             .lock()
@@ -511,14 +350,14 @@ impl Registry {
         &self,
         db: &Database,
         id: &str,
-    ) -> Result<(Entry, Option<JobStatus>), ApiError> {
+    ) -> Result<(Entry, Option<JobStatus>), CatalogError> {
         let seen = db.evictions.load(Ordering::SeqCst);
         let row = db
             .store
             .get(id)
             .await
-            .map_err(unavailable)?
-            .ok_or_else(|| ApiError::ScenarioNotFound(id.to_owned()))?;
+            .map_err(CatalogError::from)?
+            .ok_or_else(|| CatalogError::NotFound(id.to_owned()))?;
         let scenario = row.scenario;
         if predicted_precompute_ms(&scenario) > self.limits().sync_precompute_ms {
             tracing::info!(%id, "a stored scenario is precomputed here as a job");
@@ -535,9 +374,9 @@ impl Registry {
                 .store
                 .existing(&[id.to_owned()])
                 .await
-                .map_err(unavailable)?;
+                .map_err(CatalogError::from)?;
             if !present.contains(id) {
-                return Err(ApiError::ScenarioNotFound(id.to_owned()));
+                return Err(CatalogError::NotFound(id.to_owned()));
             }
         }
         Ok((Entry::Ready(self.hold(db, Arc::new(planner))), None))
@@ -582,8 +421,8 @@ impl Registry {
     /// as held here or only stored.
     ///
     /// # Errors
-    /// [`ApiError::DatabaseUnavailable`] if the database cannot be read.
-    pub async fn catalogue(&self) -> Result<Vec<Listed>, ApiError> {
+    /// [`CatalogError::DatabaseUnavailable`] if the database cannot be read.
+    pub async fn catalogue(&self) -> Result<Vec<Listed>, CatalogError> {
         let Some(db) = &self.shared.db else {
             return Ok(self
                 .list()
@@ -591,7 +430,7 @@ impl Registry {
                 .map(|(e, s)| Listed::Held(e, s))
                 .collect());
         };
-        let rows = db.store.list().await.map_err(unavailable)?;
+        let rows = db.store.list().await.map_err(CatalogError::from)?;
         let mut listed: Vec<(String, Listed)> = BUILTIN_IDS
             .iter()
             .filter_map(|id| self.entry(id))
@@ -650,9 +489,9 @@ impl Registry {
     /// spec registered through two replicas at once is created once).
     ///
     /// # Errors
-    /// [`ApiError::Internal`] if the file store fails,
-    /// [`ApiError::DatabaseUnavailable`] if the database does.
-    pub async fn insert(&self, planner: Arc<Planner>) -> Result<(Entry, bool), ApiError> {
+    /// [`CatalogError::Internal`] if the file store fails,
+    /// [`CatalogError::DatabaseUnavailable`] if the database does.
+    pub async fn insert(&self, planner: Arc<Planner>) -> Result<(Entry, bool), CatalogError> {
         if let Some((existing, _)) = self.entry(&planner.scenario.id) {
             return Ok((existing, false));
         }
@@ -661,7 +500,7 @@ impl Registry {
                 .store
                 .insert(&planner.scenario)
                 .await
-                .map_err(unavailable)?;
+                .map_err(CatalogError::from)?;
             return Ok((Entry::Ready(self.hold(db, planner)), created));
         }
         let registry = self.clone();
@@ -684,17 +523,20 @@ impl Registry {
     /// a new job.
     ///
     /// # Errors
-    /// [`ApiError::QueueFull`] when as many jobs wait as the queue holds
-    /// and none could start now; [`ApiError::Internal`] if the file store
-    /// fails, [`ApiError::DatabaseUnavailable`] if the database does.
-    pub async fn submit(&self, scenario: Scenario) -> Result<(Entry, bool), ApiError> {
+    /// [`CatalogError::QueueFull`] when as many jobs wait as the queue holds
+    /// and none could start now; [`CatalogError::Internal`] if the file store
+    /// fails, [`CatalogError::DatabaseUnavailable`] if the database does.
+    pub async fn submit(&self, scenario: Scenario) -> Result<(Entry, bool), CatalogError> {
         if let Some((existing, _)) = self.entry(&scenario.id) {
             return Ok((existing, false));
         }
         self.check_room()?;
         match &self.shared.db {
             Some(db) => {
-                db.store.insert(&scenario).await.map_err(unavailable)?;
+                db.store
+                    .insert(&scenario)
+                    .await
+                    .map_err(CatalogError::from)?;
             }
             None => {
                 let registry = self.clone();
@@ -725,13 +567,13 @@ impl Registry {
         out
     }
 
-    fn check_room(&self) -> Result<(), ApiError> {
+    fn check_room(&self) -> Result<(), CatalogError> {
         let state = self.read();
         let free_slot = state.running.len() < state.limits.jobs.max(1) && state.queue.is_empty();
         if !free_slot && state.queue.len() >= state.limits.queue {
             let wait: f64 = state.running.iter().map(|j| j.remaining_s()).sum::<f64>()
                 / state.limits.jobs.max(1) as f64;
-            return Err(ApiError::QueueFull {
+            return Err(CatalogError::QueueFull {
                 limit: state.limits.queue,
                 retry_after_s: wait.ceil().clamp(1.0, 3600.0) as u64,
             });
@@ -740,11 +582,11 @@ impl Registry {
     }
 
     /// Writes a scenario to the file store, if there is one. Blocking I/O.
-    fn save(&self, scenario: &Scenario) -> Result<(), ApiError> {
+    fn save(&self, scenario: &Scenario) -> Result<(), CatalogError> {
         match &self.shared.store {
-            Some(store) => store
-                .save(scenario)
-                .map_err(|e| ApiError::Internal(format!("storing scenario {}: {e}", scenario.id))),
+            Some(store) => store.save(scenario).map_err(|e| {
+                CatalogError::Internal(format!("storing scenario {}: {e}", scenario.id))
+            }),
             None => Ok(()),
         }
     }
@@ -816,39 +658,39 @@ impl Registry {
     /// replica; a pending one's job is cancelled at once.
     ///
     /// # Errors
-    /// [`ApiError::BuiltinScenario`] for a built-in,
-    /// [`ApiError::ScenarioNotFound`] for an unknown id,
-    /// [`ApiError::Internal`] if the file store fails and
-    /// [`ApiError::DatabaseUnavailable`] if the database does.
-    pub async fn remove(&self, id: &str) -> Result<(), ApiError> {
+    /// [`CatalogError::Builtin`] for a built-in,
+    /// [`CatalogError::NotFound`] for an unknown id,
+    /// [`CatalogError::Internal`] if the file store fails and
+    /// [`CatalogError::DatabaseUnavailable`] if the database does.
+    pub async fn remove(&self, id: &str) -> Result<(), CatalogError> {
         if Self::is_builtin(id) {
-            return Err(ApiError::BuiltinScenario(id.to_owned()));
+            return Err(CatalogError::Builtin(id.to_owned()));
         }
         if let Some(db) = &self.shared.db {
-            let existed = derivable(id) && db.store.delete(id).await.map_err(unavailable)?;
+            let existed = derivable(id) && db.store.delete(id).await.map_err(CatalogError::from)?;
             // Every replica evicts it on the notification; this one at once.
             self.evict(id);
             return if existed {
                 Ok(())
             } else {
-                Err(ApiError::ScenarioNotFound(id.to_owned()))
+                Err(CatalogError::NotFound(id.to_owned()))
             };
         }
         if self.entry(id).is_none() {
-            return Err(ApiError::ScenarioNotFound(id.to_owned()));
+            return Err(CatalogError::NotFound(id.to_owned()));
         }
         let registry = self.clone();
         let owned = id.to_owned();
         tokio::task::spawn_blocking(move || {
             if let Some(store) = &registry.shared.store {
-                store
-                    .remove(&owned)
-                    .map_err(|e| ApiError::Internal(format!("removing scenario {owned}: {e}")))?;
+                store.remove(&owned).map_err(|e| {
+                    CatalogError::Internal(format!("removing scenario {owned}: {e}"))
+                })?;
             }
             if registry.evict(&owned) {
                 Ok(())
             } else {
-                Err(ApiError::ScenarioNotFound(owned))
+                Err(CatalogError::NotFound(owned))
             }
         })
         .await?
@@ -910,63 +752,6 @@ impl Registry {
         Ok(dropped)
     }
 
-    /// With a database, starts the background tasks on the current tokio
-    /// runtime: one follows deletions (evicting each deleted id at once,
-    /// and after every (re)connection checking what is held against the
-    /// table, see [`Registry::recheck`]); one checks every second that the
-    /// database answers (`/healthz`, `vigil_database_up`). Without one,
-    /// does nothing.
-    pub fn watch(&self) {
-        let Some(db) = &self.shared.db else {
-            return;
-        };
-        let store = db.store.clone();
-        tokio::spawn(async move {
-            loop {
-                store.ping().await;
-                tokio::time::sleep(Duration::from_secs(1)).await;
-            }
-        });
-        let registry = self.clone();
-        tokio::spawn(async move {
-            let Some(store) = registry.database().cloned() else {
-                return;
-            };
-            loop {
-                match store.listen().await {
-                    Ok(mut deletions) => match registry.recheck().await {
-                        Ok(dropped) => {
-                            tracing::info!(dropped, "following deletions in the database");
-                            loop {
-                                let next = tokio::select! {
-                                    next = deletions.next() => next,
-                                    // A connection cut without a reset
-                                    // never ends `next`: the check every
-                                    // second notices it instead.
-                                    () = down(&store) => Err(DbError::Down),
-                                };
-                                match next {
-                                    Ok(id) => {
-                                        if registry.evict(&id) {
-                                            tracing::info!(%id, "dropped a scenario deleted through another replica");
-                                        }
-                                    }
-                                    Err(e) => {
-                                        tracing::warn!(error = %e, "lost the database's deletion notifications; reconnecting");
-                                        break;
-                                    }
-                                }
-                            }
-                        }
-                        Err(e) => tracing::warn!(error = %e, "cannot check the held scenarios"),
-                    },
-                    Err(e) => tracing::debug!(error = %e, "cannot follow deletions yet"),
-                }
-                tokio::time::sleep(Duration::from_millis(250)).await;
-            }
-        });
-    }
-
     /// Waits until no job runs or waits, up to `timeout` (for tests and
     /// tools); true if they all ended.
     pub fn wait_idle(&self, timeout: Duration) -> bool {
@@ -983,20 +768,5 @@ impl Registry {
             }
             std::thread::sleep(Duration::from_millis(5));
         }
-    }
-}
-
-/// Resolves once the database's check every second has failed.
-async fn down(store: &PgStore) {
-    while store.is_up() {
-        tokio::time::sleep(Duration::from_millis(200)).await;
-    }
-}
-
-/// The id of an entry's scenario.
-pub fn entry_id(entry: &Entry) -> &str {
-    match entry {
-        Entry::Ready(p) => &p.scenario.id,
-        Entry::Pending(j) => &j.scenario.id,
     }
 }
