@@ -6,12 +6,12 @@ use std::sync::Arc;
 use axum::Extension;
 use axum::extract::State;
 
-use super::AppState;
+use super::doc::{self, examples};
 use super::error::ApiError;
 use super::extract::{Json, Path, QueuedJson};
 use super::middleware::RequestStart;
-use super::openapi::{self as doc, examples};
-use super::plan::{CancelOnDrop, with_scenario};
+use super::planning::{CancelOnDrop, with_scenario};
+use super::state::AppState;
 use crate::coordination::Coordination;
 use crate::cost;
 use crate::evaluate::{EvaluateInput, EvaluateRequest, EvaluateResponse};
@@ -42,7 +42,7 @@ async fn evaluate_admitted(
     }
     let guard = CancelOnDrop::new("evaluate", start, state);
     let token = guard.token();
-    let res = super::on_rayon(move || planner.evaluate(&input, &token)).await;
+    let res = super::queue::on_rayon(move || planner.evaluate(&input, &token)).await;
     guard.finish();
     res?.map_err(|_| ApiError::Timeout)
 }

@@ -82,10 +82,10 @@ where
     type Rejection = ApiError;
 
     async fn from_request(req: Request, state: &S) -> Result<Self, ApiError> {
-        if super::queue_full() {
+        if super::queue::queue_full() {
             // Drained, not parsed; a body too large is refused as usual.
             Bytes::from_request(req, state).await?;
-            super::count_shed();
+            super::queue::count_shed();
             return Err(ApiError::Overloaded);
         }
         let Json(value) = Json::<T>::from_request(req, state).await?;

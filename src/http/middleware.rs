@@ -12,8 +12,8 @@ use metrics_exporter_prometheus::{PrometheusBuilder, PrometheusHandle};
 use subtle::ConstantTimeEq;
 use tower::BoxError;
 
-use super::AppState;
 use super::error::ApiError;
+use super::state::AppState;
 
 /// Requires `Authorization: Bearer <key>` when an API key is configured;
 /// the key is compared in constant time.

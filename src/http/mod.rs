@@ -57,6 +57,7 @@ macro_rules! path_rules {
 }
 
 pub mod config;
+pub mod doc;
 pub mod error;
 pub mod evaluate;
 pub mod extract;
@@ -64,12 +65,13 @@ pub mod health;
 pub mod middleware;
 pub mod openapi;
 pub mod plan;
+pub mod planning;
+pub mod queue;
 pub mod scenarios;
 pub mod serve;
+pub mod session_store;
 pub mod sessions;
-
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Arc, OnceLock};
+pub mod state;
 
 use axum::Router;
 use axum::error_handling::HandleErrorLayer;
@@ -83,211 +85,12 @@ use tower_http::request_id::{MakeRequestUuid, PropagateRequestIdLayer, SetReques
 use tower_http::trace::{DefaultOnFailure, TraceLayer};
 use tracing::Level;
 
-use self::config::{Config, Settings};
-use crate::catalog::{PlannerCache, Registry};
 use crate::limits::MAX_BODY_BYTES;
-use crate::store::{PgStore, Store};
 
 pub use error::{ApiError, Problem};
-
-/// Pieces of work that may wait for a rayon worker, per worker; past that,
-/// more are shed at once with 503. Eight plans of the reference workload
-/// are ~5 ms of queue: a burst is absorbed, while under sustained overload
-/// clients hear "retry" at once instead of timing out in a queue that only
-/// grows (and the server would then be planning for clients already gone).
-pub const QUEUE_PER_WORKER: usize = 8;
-
-/// Work admitted to rayon at once: one piece per worker. With more, the
-/// pieces would interleave on the workers (a worker waiting in a join runs
-/// other jobs meanwhile), so all of them would finish late together, their
-/// working sets evicting each other from cache. The rest wait here in
-/// arrival order (the semaphore is fair), and a request whose client leaves
-/// while waiting is never computed.
-struct WorkQueue {
-    slots: Arc<tokio::sync::Semaphore>,
-    waiting: AtomicUsize,
-    max_waiting: usize,
-}
-
-fn work_queue() -> &'static WorkQueue {
-    static QUEUE: OnceLock<WorkQueue> = OnceLock::new();
-    QUEUE.get_or_init(|| {
-        let workers = rayon::current_num_threads();
-        WorkQueue {
-            slots: Arc::new(tokio::sync::Semaphore::new(workers)),
-            waiting: AtomicUsize::new(0),
-            max_waiting: QUEUE_PER_WORKER * workers,
-        }
-    })
-}
-
-/// Counts a request as waiting while it exists (a cancelled wait included).
-struct Waiting<'a>(&'a AtomicUsize);
-
-impl Drop for Waiting<'_> {
-    fn drop(&mut self) {
-        self.0.fetch_sub(1, Ordering::Relaxed);
-    }
-}
-
-/// Runs CPU work (a plan) on rayon's global pool and awaits its result:
-/// one hop from the async worker straight to the thread that plans, whose
-/// parallel parts then split without further hand-offs (see
-/// [`Planner::plan`](crate::planner::Planner::plan)). At most one piece runs per worker; up to
-/// [`QUEUE_PER_WORKER`] per worker wait, in arrival order.
-///
-/// # Errors
-/// [`ApiError::Overloaded`] when the queue is full, and
-/// [`ApiError::Internal`] if the work panicked.
-pub async fn on_rayon<T: Send + 'static>(
-    work: impl FnOnce() -> T + Send + 'static,
-) -> Result<T, ApiError> {
-    let permit = admit().await?;
-    let (tx, rx) = tokio::sync::oneshot::channel();
-    rayon::spawn(move || {
-        // Held until the work ends, even when the client has left.
-        let _permit = permit;
-        // A request dropped while queued (client gone, timed out) is not
-        // planned: under overload, dead work would otherwise fill the queue
-        // and starve the live requests.
-        if tx.is_closed() {
-            return;
-        }
-        // A panic becomes a 500 (rayon would abort the process).
-        let _ = tx.send(std::panic::catch_unwind(std::panic::AssertUnwindSafe(work)));
-    });
-    match rx.await {
-        Ok(Ok(value)) => Ok(value),
-        Ok(Err(_)) => Err(ApiError::Internal("the planning task panicked".into())),
-        Err(_) => Err(ApiError::Internal("the planning task was lost".into())),
-    }
-}
-
-/// A place among the workers for one piece of work: at once when one is
-/// free, else after those queued before it, or [`ApiError::Overloaded`]
-/// at once when the queue is full.
-async fn admit() -> Result<tokio::sync::OwnedSemaphorePermit, ApiError> {
-    let queue = work_queue();
-    match queue.slots.clone().try_acquire_owned() {
-        Ok(permit) => Ok(permit),
-        Err(_) => {
-            if queue.waiting.fetch_add(1, Ordering::Relaxed) >= queue.max_waiting {
-                queue.waiting.fetch_sub(1, Ordering::Relaxed);
-                count_shed();
-                return Err(ApiError::Overloaded);
-            }
-            let _waiting = Waiting(&queue.waiting);
-            queue
-                .slots
-                .clone()
-                .acquire_owned()
-                .await
-                .map_err(|_| ApiError::Internal("the work queue is closed".into()))
-        }
-    }
-}
-
-/// Runs short CPU work on this async worker, admitted like [`on_rayon`]'s
-/// (one piece per rayon worker, the same queue and shedding): for a pool of
-/// one thread, the hop to it and back costs two thread switches a request
-/// on a core that does both. Only for work of a few milliseconds: this
-/// worker serves no other request meanwhile, and a deadline cannot stop it
-/// before it ends.
-///
-/// # Errors
-/// As [`on_rayon`].
-pub async fn on_this_worker<T>(work: impl FnOnce() -> T) -> Result<T, ApiError> {
-    let _permit = admit().await?;
-    // The requests that arrived meanwhile queue (or are shed) first.
-    tokio::task::yield_now().await;
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(work))
-        .map_err(|_| ApiError::Internal("the planning task panicked".into()))
-}
-
-/// True when work sent to [`on_rayon`] now would be shed: every worker
-/// busy and the queue full. A hint for shedding a request before its body
-/// is parsed ([`extract::QueuedJson`]); `on_rayon` decides for itself.
-pub(crate) fn queue_full() -> bool {
-    let queue = work_queue();
-    queue.slots.available_permits() == 0
-        && queue.waiting.load(Ordering::Relaxed) >= queue.max_waiting
-}
-
-/// Counts a request shed for load.
-pub(crate) fn count_shed() {
-    metrics::counter!("vigil_http_shed_total").increment(1);
-}
-
-/// State shared by every handler.
-#[derive(Debug, Clone)]
-pub struct AppState {
-    /// The registered scenarios.
-    pub registry: Arc<Registry>,
-    /// Planners of scenarios planned inline (`POST /v1/plan`).
-    pub cache: Arc<PlannerCache>,
-    /// Step-by-step clients' sessions.
-    pub sessions: Arc<sessions::SessionStore>,
-    /// Limits, keys and CORS.
-    pub settings: Arc<Settings>,
-}
-
-impl AppState {
-    /// State with the built-in scenarios registered, nothing stored and
-    /// default settings (precomputes the built-ins, which is CPU work: call
-    /// it at startup).
-    pub fn new() -> Self {
-        Self::with_registry(Registry::with_builtins())
-    }
-
-    /// State over a given registry, with default settings.
-    pub fn with_registry(registry: Registry) -> Self {
-        Self::with_settings(registry, Settings::default())
-    }
-
-    /// State over a given registry and settings (which set the registry's
-    /// bounds on precomputation).
-    pub fn with_settings(registry: Registry, settings: Settings) -> Self {
-        registry.set_limits(settings.job_limits());
-        Self {
-            registry: Arc::new(registry),
-            cache: Arc::new(PlannerCache::new(settings.cache_bytes)),
-            sessions: Arc::new(sessions::SessionStore::new(
-                settings.session_ttl,
-                settings.max_sessions,
-            )),
-            settings: Arc::new(settings),
-        }
-    }
-
-    /// State from the server's configuration: opens the store under
-    /// `data_dir` and rebuilds the statistics of what it holds.
-    pub fn from_config(config: &Config) -> std::io::Result<Self> {
-        let (store, stored) = Store::open(&config.data_dir)?;
-        let settings = Settings::from(config);
-        Ok(Self::with_settings(
-            Registry::with_store(store, stored, settings.job_limits()),
-            settings,
-        ))
-    }
-}
-
-impl AppState {
-    /// State from the server's configuration with scenarios in the
-    /// database `store` (connected and migrated): starts following its
-    /// deletions on the current runtime ([`Registry::watch`]).
-    pub fn from_database(config: &Config, store: PgStore) -> Self {
-        let settings = Settings::from(config);
-        let registry = Registry::with_database(store, settings.job_limits(), settings.cache_bytes);
-        registry.watch();
-        Self::with_settings(registry, settings)
-    }
-}
-
-impl Default for AppState {
-    fn default() -> Self {
-        Self::new()
-    }
-}
+pub use queue::{QUEUE_PER_WORKER, on_rayon, on_this_worker};
+pub use session_store::SessionStore;
+pub use state::AppState;
 
 /// The application: every route; on /v1, the API key check (when set), then
 /// load shedding past a global concurrency limit (503) and a time limit
@@ -378,120 +181,5 @@ async fn method_not_allowed(method: Method, uri: Uri) -> ApiError {
     ApiError::MethodNotAllowed {
         method: method.to_string(),
         path: uri.path().to_owned(),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use std::sync::Arc;
-    use std::sync::atomic::{AtomicUsize, Ordering};
-    use std::time::Duration;
-
-    use axum::extract::FromRequest;
-
-    use super::{ApiError, QUEUE_PER_WORKER, extract, on_rayon, queue_full, work_queue};
-
-    /// The tests here share rayon's pool and the work queue: one at a time.
-    static SERIAL: tokio::sync::Mutex<()> = tokio::sync::Mutex::const_new(());
-
-    #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
-    async fn work_past_the_queue_is_shed_at_once() {
-        let _serial = SERIAL.lock().await;
-        let workers = rayon::current_num_threads();
-        let release = Arc::new(AtomicUsize::new(0));
-        let running = Arc::new(AtomicUsize::new(0));
-        let hold = |release: Arc<AtomicUsize>, running: Arc<AtomicUsize>| {
-            move || {
-                running.fetch_add(1, Ordering::SeqCst);
-                while release.load(Ordering::SeqCst) == 0 {
-                    std::thread::sleep(Duration::from_millis(1));
-                }
-            }
-        };
-        let mut tasks = Vec::new();
-        for _ in 0..workers {
-            tasks.push(tokio::spawn(on_rayon(hold(
-                release.clone(),
-                running.clone(),
-            ))));
-        }
-        while running.load(Ordering::SeqCst) < workers {
-            tokio::time::sleep(Duration::from_millis(1)).await;
-        }
-        for _ in 0..QUEUE_PER_WORKER * workers {
-            tasks.push(tokio::spawn(on_rayon(hold(
-                release.clone(),
-                running.clone(),
-            ))));
-        }
-        while work_queue().waiting.load(Ordering::SeqCst) < QUEUE_PER_WORKER * workers {
-            tokio::time::sleep(Duration::from_millis(1)).await;
-        }
-        // The queue is full: the next is shed without waiting, and a body
-        // for the queue is not even parsed (this one would be a 400).
-        let shed = on_rayon(|| ()).await;
-        assert!(matches!(shed, Err(ApiError::Overloaded)), "{shed:?}");
-        assert!(queue_full());
-        let body = |text: &'static str| {
-            axum::http::Request::builder()
-                .method("POST")
-                .header("content-type", "application/json")
-                .body(axum::body::Body::from(text))
-                .expect("a request")
-        };
-        type Queued = extract::QueuedJson<serde_json::Value>;
-        let shed = Queued::from_request(body("{not json"), &()).await;
-        assert!(matches!(shed, Err(ApiError::Overloaded)), "{shed:?}");
-        release.store(1, Ordering::SeqCst);
-        for task in tasks {
-            task.await.expect("joined").expect("queued work runs");
-        }
-        assert!(!queue_full());
-        let parsed = Queued::from_request(body("{not json"), &()).await;
-        assert!(
-            matches!(parsed, Err(ApiError::MalformedBody(_))),
-            "{parsed:?}"
-        );
-        let parsed = Queued::from_request(body(r#"{"a": 1}"#), &()).await;
-        assert!(matches!(parsed, Ok(extract::QueuedJson(v)) if v["a"] == 1));
-        assert_eq!(
-            running.load(Ordering::SeqCst),
-            (QUEUE_PER_WORKER + 1) * workers
-        );
-        assert_eq!(work_queue().waiting.load(Ordering::SeqCst), 0);
-    }
-
-    /// Work that splits (as a plan does) must not interleave with other
-    /// work on rayon's workers: at most one piece per worker is running.
-    #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
-    async fn work_pieces_run_at_most_one_per_worker() {
-        let _serial = SERIAL.lock().await;
-        let running = Arc::new(AtomicUsize::new(0));
-        let most = Arc::new(AtomicUsize::new(0));
-        let tasks: Vec<_> = (0..12)
-            .map(|_| {
-                let (running, most) = (running.clone(), most.clone());
-                tokio::spawn(on_rayon(move || {
-                    let now = running.fetch_add(1, Ordering::SeqCst) + 1;
-                    most.fetch_max(now, Ordering::SeqCst);
-                    // A worker waiting here for the stolen half would run
-                    // other queued jobs meanwhile, were any admitted.
-                    rayon::join(
-                        || std::thread::sleep(Duration::from_millis(5)),
-                        || std::thread::sleep(Duration::from_millis(30)),
-                    );
-                    running.fetch_sub(1, Ordering::SeqCst);
-                }))
-            })
-            .collect();
-        for task in tasks {
-            task.await.expect("joined").expect("ran");
-        }
-        let most = most.load(Ordering::SeqCst);
-        assert!(
-            most <= rayon::current_num_threads(),
-            "{most} pieces ran at once on {} workers",
-            rayon::current_num_threads()
-        );
     }
 }

@@ -11,12 +11,12 @@ use utoipa::ToSchema;
 
 use axum::Extension;
 
-use super::AppState;
+use super::doc::{self, examples};
 use super::error::ApiError;
 use super::extract::{Json, Path};
 use super::middleware::RequestStart;
-use super::openapi::{self as doc, examples};
-use super::plan::CancelOnDrop;
+use super::planning::CancelOnDrop;
+use super::state::AppState;
 use crate::cancel::Progress;
 use crate::catalog::{
     Entry, JobStatus, Listed, entry_id, precompute_cancellable, predicted_precompute_ms,

@@ -151,13 +151,13 @@ fn content_type(res: &Response) -> String {
 /// A small valid scenario spec: a 100×100 zone of 10-unit cells, two
 /// sources (the OpenAPI document's example).
 pub fn small_spec() -> Value {
-    vigil::http::openapi::examples::small_spec()
+    vigil::http::doc::examples::small_spec()
 }
 
 /// A valid plan request on `paper-v10`: three sensors, a few targets (the
 /// OpenAPI document's example).
 pub fn plan_request() -> Value {
-    vigil::http::openapi::examples::plan_request()
+    vigil::http::doc::examples::plan_request()
 }
 
 /// `a` and `b` agree within `rel` relative error.

@@ -1,0 +1,187 @@
+//! Request bodies as the document describes them: the shapes the handlers
+//! parse by hand (a scenario by id or inline), which no wire type derives.
+
+use utoipa::ToSchema;
+
+use crate::coordination::Coordination;
+use crate::evaluate::SensorPathIn;
+use crate::planner::{EstimatorKind, Observed, PositionIn, SensorIn, TargetIn};
+use crate::scenario::{Integer, ScenarioSpec};
+
+/// The fields of `POST /v1/scenarios/{id}/plan`'s body ([`PlanRequest`]
+/// for the schema) with one more, required: the two shapes of the body of
+/// `POST /v1/plan`.
+macro_rules! plan_request_with {
+    ($(#[$doc:meta])* $name:ident, $($(#[$field_doc:meta])* $field:ident: $ty:ty),+ $(,)?) => {
+        $(#[$doc])*
+        #[derive(Debug, ToSchema)]
+        #[serde(deny_unknown_fields)]
+        pub struct $name {
+            $(
+                $(#[$field_doc])*
+                pub $field: $ty,
+            )+
+            /// Sensors now.
+            #[schema(min_items = 1, max_items = 256)]
+            pub sensors: Vec<SensorIn>,
+            /// Targets reported now.
+            #[serde(default)]
+            #[schema(max_items = 20000)]
+            pub targets: Vec<TargetIn>,
+            /// Sensors' positions 1, 2, … steps ago (at most 256 a step).
+            #[schema(max_items = 32)]
+            pub history: Option<Vec<Vec<PositionIn>>>,
+            /// Horizon T; the scenario's by default.
+            #[schema(value_type = Option<u32>, minimum = 1, maximum = 12)]
+            pub horizon: Option<Integer>,
+            /// Estimator; `exact` by default.
+            pub estimator: Option<EstimatorKind>,
+            /// Coordination; `priority` by default.
+            pub coordination: Option<Coordination>,
+            /// What the reported targets cover; `sensors` by default.
+            pub observed: Option<Observed>,
+            /// Include the search values in the response.
+            pub explain: Option<bool>,
+            /// Minimum separation between sensors at every step, cells
+            /// (Chebyshev distance; 0..=16, 0 = no rule); the scenario's by
+            /// default. Kept wherever it can be: a sensor that cannot keep
+            /// it takes the path with the fewest violations, which the
+            /// response counts.
+            #[schema(value_type = Option<u32>, minimum = 0, maximum = 16)]
+            pub min_separation: Option<Integer>,
+            /// With `coordination: joint`: the certified gap at which it
+            /// stops, in `[0, 1]`; 0.001 by default.
+            #[schema(minimum = 0.0, maximum = 1.0)]
+            pub gap_target: Option<f64>,
+            /// With `coordination: joint`: the most time the plan may
+            /// take, milliseconds (1..=1000, 20 by default).
+            #[schema(value_type = Option<u32>, minimum = 1, maximum = 1000)]
+            pub budget_ms: Option<Integer>,
+        }
+    };
+}
+
+plan_request_with!(
+    /// `POST /v1/plan` naming its scenario.
+    PlanRequestById,
+    /// Id of a registered scenario, or of one sent inline before.
+    #[schema(example = "paper-v10")]
+    scenario_id: String
+);
+
+plan_request_with!(
+    /// `POST /v1/plan` carrying its scenario.
+    PlanRequestWithScenario,
+    /// The scenario itself; precomputed on first use and cached.
+    scenario: ScenarioSpec
+);
+
+/// Body of `POST /v1/plan`: the body of `POST /v1/scenarios/{id}/plan` plus
+/// exactly one of `scenario_id` and `scenario`.
+#[derive(Debug, ToSchema)]
+#[serde(untagged)]
+pub enum InlinePlanRequest {
+    /// The scenario by id.
+    ById(PlanRequestById),
+    /// The scenario inline.
+    WithScenario(PlanRequestWithScenario),
+}
+
+plan_request_with!(
+    /// Body of `POST /v1/scenarios/{id}/evaluate`: a plan request's fields
+    /// (its `coordination`, `explain`, `gap_target` and `budget_ms` play no
+    /// part) and the paths to score.
+    EvaluateBody,
+    /// One path per sensor.
+    #[schema(min_items = 1, max_items = 256)]
+    paths: Vec<SensorPathIn>
+);
+
+plan_request_with!(
+    /// `POST /v1/evaluate` naming its scenario.
+    EvaluateRequestById,
+    /// Id of a registered scenario, or of one sent inline before.
+    #[schema(example = "paper-v10")]
+    scenario_id: String,
+    /// One path per sensor.
+    #[schema(min_items = 1, max_items = 256)]
+    paths: Vec<SensorPathIn>,
+);
+
+plan_request_with!(
+    /// `POST /v1/evaluate` carrying its scenario.
+    EvaluateRequestWithScenario,
+    /// The scenario itself; precomputed on first use and cached.
+    scenario: ScenarioSpec,
+    /// One path per sensor.
+    #[schema(min_items = 1, max_items = 256)]
+    paths: Vec<SensorPathIn>,
+);
+
+/// Body of `POST /v1/evaluate`: the body of `POST
+/// /v1/scenarios/{id}/evaluate` plus exactly one of `scenario_id` and
+/// `scenario`.
+#[derive(Debug, ToSchema)]
+#[serde(untagged)]
+pub enum InlineEvaluateRequest {
+    /// The scenario by id.
+    ById(EvaluateRequestById),
+    /// The scenario inline.
+    WithScenario(EvaluateRequestWithScenario),
+}
+
+macro_rules! session_request_with {
+    ($(#[$doc:meta])* $name:ident, $(#[$field_doc:meta])* $field:ident: $ty:ty) => {
+        $(#[$doc])*
+        #[derive(Debug, ToSchema)]
+        #[serde(deny_unknown_fields)]
+        pub struct $name {
+            $(#[$field_doc])*
+            pub $field: $ty,
+            /// Horizon T of its steps; the scenario's by default.
+            #[schema(value_type = Option<u32>, minimum = 1, maximum = 12)]
+            pub horizon: Option<Integer>,
+            /// Estimator of its steps; `exact` by default.
+            pub estimator: Option<EstimatorKind>,
+            /// Coordination of its steps; `priority` by default.
+            pub coordination: Option<Coordination>,
+            /// What the detections cover; `sensors` by default.
+            pub observed: Option<Observed>,
+            /// Minimum separation of its steps, cells (0..=16); the
+            /// scenario's by default.
+            #[schema(value_type = Option<u32>, minimum = 0, maximum = 16)]
+            pub min_separation: Option<Integer>,
+            /// Steps of history kept (0..=32, 16 by default): the sensors'
+            /// past positions planned with, and how long a track lives
+            /// undetected.
+            #[schema(value_type = Option<u32>, minimum = 0, maximum = 32)]
+            pub history_steps: Option<Integer>,
+        }
+    };
+}
+
+session_request_with!(
+    /// `POST /v1/sessions` naming its scenario.
+    SessionRequestById,
+    /// Id of a registered scenario, or of one sent inline before.
+    #[schema(example = "paper-v10")]
+    scenario_id: String
+);
+
+session_request_with!(
+    /// `POST /v1/sessions` carrying its scenario.
+    SessionRequestWithScenario,
+    /// The scenario itself; precomputed on first use and cached.
+    scenario: ScenarioSpec
+);
+
+/// Body of `POST /v1/sessions`: exactly one of `scenario_id` and
+/// `scenario`, and the defaults of the session's steps.
+#[derive(Debug, ToSchema)]
+#[serde(untagged)]
+pub enum CreateSessionRequest {
+    /// The scenario by id.
+    ById(SessionRequestById),
+    /// The scenario inline.
+    WithScenario(SessionRequestWithScenario),
+}
