@@ -6,9 +6,9 @@
 //! one, and the `explain` switch draws.
 //! A screenshot goes to the target directory.
 //!
-//! Without a browser this test FAILS: `.ci/run` installs Debian's
-//! `chromium` and `chromium-driver`. `CHROMEDRIVER` and `CHROMIUM` override
-//! where they are looked for.
+//! Without a browser this test installs Debian's `chromium` and
+//! `chromium-driver` (see `vigil_testenv::chromium`), and FAILS when it
+//! cannot. `CHROMEDRIVER` and `CHROMIUM` name other executables.
 
 use std::net::TcpListener as StdListener;
 use std::path::PathBuf;
@@ -24,17 +24,6 @@ use vigil_sim::live::{Live, LiveOptions};
 use vigil_sim::policy::Policy;
 
 const SENSORS: usize = 6;
-
-/// The first of `names` found on the PATH (or the override in `var`).
-fn find(var: &str, names: &[&str]) -> Option<PathBuf> {
-    if let Some(p) = std::env::var_os(var) {
-        return Some(PathBuf::from(p));
-    }
-    let path = std::env::var_os("PATH")?;
-    std::env::split_paths(&path)
-        .flat_map(|dir| names.iter().map(move |n| dir.join(n)))
-        .find(|p| p.is_file())
-}
 
 /// Kills chromedriver when the test ends, however it ends.
 struct Driver(Child);
@@ -82,25 +71,11 @@ where
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn live_view_in_headless_chromium() {
+    let vigil_testenv::Browser {
+        chromium,
+        chromedriver,
+    } = vigil_testenv::chromium();
     let started = Instant::now();
-    let Some(chromedriver) = find("CHROMEDRIVER", &["chromedriver"]) else {
-        panic!(
-            "\n\n*** NO BROWSER: chromedriver is not on the PATH. This test needs a real \
-             headless Chromium; install it with `apt-get install -y chromium chromium-driver` \
-             (as .ci/run does) or set CHROMEDRIVER and CHROMIUM. FAILING. ***\n"
-        );
-    };
-    let chromium = find(
-        "CHROMIUM",
-        &["chromium", "chromium-browser", "google-chrome", "chrome"],
-    );
-    let Some(chromium) = chromium else {
-        panic!(
-            "\n\n*** NO BROWSER: chromium is not on the PATH (chromedriver is at {}). \
-             Install `chromium` or set CHROMIUM. FAILING. ***\n",
-            chromedriver.display()
-        );
-    };
 
     // The live view of a short run, on a loopback port 0.
     let base = spawn_local_server().await.expect("in-process planner");

@@ -292,6 +292,8 @@ async fn scenarios_survive_kill_9_and_corrupt_files_are_skipped() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn sigterm_finishes_the_plan_in_flight_then_exits_0() {
+    // Found (or installed) first: the signal must come while the plan runs.
+    let kill = vigil_testenv::kill();
     let dir = temp_dir("shutdown");
     let mut server = Server::start_with(&dir, &["--max-plan-ms", "0"]);
     let url = format!("{}/v1/scenarios/paper-v10/plan", server.address);
@@ -308,7 +310,7 @@ async fn sigterm_finishes_the_plan_in_flight_then_exits_0() {
     tokio::time::sleep(Duration::from_millis(150)).await;
     let pid = server.child.id().to_string();
     let signalled = started.elapsed();
-    let killed = Command::new("kill").args(["-TERM", &pid]).status().unwrap();
+    let killed = Command::new(kill).args(["-TERM", &pid]).status().unwrap();
     assert!(killed.success());
     let (res, answered) = in_flight.await.unwrap();
     let res = res.expect("the in-flight plan completes");

@@ -4,14 +4,8 @@
 //! With `VIGIL_TEST_DATABASE_URL` set, the tests use that server instead
 //! (those that stop the database then fail: they need a server of their own).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::Command;
-
-/// What to install when no PostgreSQL can be started.
-pub const INSTALL_HINT: &str = "the database tests need PostgreSQL's server programs (initdb, \
-    pg_ctl, postgres): install them (Debian/Ubuntu: `apt-get install postgresql`; they are found \
-    in /usr/lib/postgresql/*/bin, through pg_config, on PATH, or in $VIGIL_PG_BIN), or set \
-    VIGIL_TEST_DATABASE_URL to a server where the tests may create databases";
 
 /// The server the tests use.
 pub struct Cluster {
@@ -29,10 +23,12 @@ struct Own {
 }
 
 impl Cluster {
-    /// The server of `VIGIL_TEST_DATABASE_URL`, or a new one.
+    /// The server of `VIGIL_TEST_DATABASE_URL`, or a new one, with
+    /// PostgreSQL's programs installed first if they are missing (see
+    /// `vigil_testenv::postgres_bindir`).
     ///
     /// # Panics
-    /// If there is neither, with [`INSTALL_HINT`].
+    /// If there is neither, with what to install and why it was not.
     pub fn start() -> Cluster {
         if let Ok(url) = std::env::var("VIGIL_TEST_DATABASE_URL")
             && !url.is_empty()
@@ -46,8 +42,8 @@ impl Cluster {
                 own: None,
             };
         }
-        let bin = find_bin().unwrap_or_else(|| panic!("{INSTALL_HINT}"));
-        let as_postgres = is_root();
+        let bin = vigil_testenv::postgres_bindir();
+        let as_postgres = vigil_testenv::is_root();
         let dir = std::env::temp_dir().join(format!("vigil-pg-test-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).expect("a temporary directory");
@@ -180,50 +176,13 @@ impl Drop for Cluster {
 fn run(cmd: &mut Command, what: &str) {
     let out = cmd
         .output()
-        .unwrap_or_else(|e| panic!("cannot run {what}: {e}; {INSTALL_HINT}"));
+        .unwrap_or_else(|e| panic!("cannot run {what}: {e}"));
     assert!(
         out.status.success(),
         "{what} failed: {}\n{}",
         String::from_utf8_lossy(&out.stdout),
         String::from_utf8_lossy(&out.stderr)
     );
-}
-
-fn is_root() -> bool {
-    Command::new("id")
-        .arg("-u")
-        .output()
-        .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0")
-}
-
-/// The directory of `initdb` and `pg_ctl`: `$VIGIL_PG_BIN`, the newest
-/// /usr/lib/postgresql/*/bin, `pg_config --bindir`, or PATH.
-fn find_bin() -> Option<PathBuf> {
-    let has = |d: &Path| d.join("initdb").is_file() && d.join("pg_ctl").is_file();
-    if let Ok(dir) = std::env::var("VIGIL_PG_BIN") {
-        return Some(PathBuf::from(dir)).filter(|d| has(d));
-    }
-    let mut versions: Vec<(u32, PathBuf)> = std::fs::read_dir("/usr/lib/postgresql")
-        .into_iter()
-        .flatten()
-        .filter_map(|e| e.ok())
-        .filter_map(|e| {
-            let v = e.file_name().to_string_lossy().parse::<u32>().ok()?;
-            Some((v, e.path().join("bin")))
-        })
-        .filter(|(_, d)| has(d))
-        .collect();
-    versions.sort();
-    if let Some((_, dir)) = versions.pop() {
-        return Some(dir);
-    }
-    if let Ok(out) = Command::new("pg_config").arg("--bindir").output() {
-        let dir = PathBuf::from(String::from_utf8_lossy(&out.stdout).trim());
-        if has(&dir) {
-            return Some(dir);
-        }
-    }
-    std::env::var_os("PATH").and_then(|p| std::env::split_paths(&p).find(|d| has(d)))
 }
 
 fn free_port() -> u16 {

@@ -425,9 +425,9 @@ async fn newer_schema_refused(cluster: Arc<Cluster>) {
 async fn database_outage(cluster: Arc<Cluster>) {
     assert!(
         cluster.owned(),
-        "this test stops and starts the database: it needs PostgreSQL's programs \
-         (unset VIGIL_TEST_DATABASE_URL; {})",
-        crate::cluster::INSTALL_HINT
+        "this test stops and starts the database: it needs a server of its own (unset \
+         VIGIL_TEST_DATABASE_URL: the tests then start one, and install PostgreSQL's programs \
+         if they are missing)"
     );
     let url = cluster.database("outage").await;
     let timeout_ms = 3000;
