@@ -364,7 +364,7 @@ fn the_graph_sees_known_imports() {
     let m = |s: &str| s.split("::").map(String::from).collect::<Module>();
     assert!(edges[&m("stats")].contains(&m("scenario")));
     assert!(edges[&m("stats")].contains(&m("geometry")));
-    assert!(edges[&m("planner")].contains(&m("limits")));
+    assert!(edges[&m("planner::input")].contains(&m("limits")));
     assert!(edges[&m("estimator::exact")].contains(&m("estimator::exact::windows")));
 }
 

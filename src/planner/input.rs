@@ -1,0 +1,206 @@
+//! A plan request validated against its scenario, once: [`PlanInput`]
+//! (parse, don't validate). Every bound a request can break is checked
+//! here, with a [`ValidationError`] that names the field.
+
+use std::collections::HashSet;
+
+use super::wire::*;
+use crate::coordination::{Coordination, JointSettings};
+use crate::estimator::Target;
+use crate::geometry::Point;
+use crate::limits::{
+    MAX_BUDGET_MS, MAX_HISTORY_POSITIONS, MAX_HISTORY_STEPS, MAX_SENSORS, MAX_TARGETS,
+};
+use crate::scenario::{
+    Cell, DEFAULT_TYPE, Scenario, ValidationError, check_horizon, check_min_separation,
+};
+
+/// A validated plan request.
+#[derive(Debug, Clone)]
+pub struct PlanInput {
+    pub(crate) ids: Vec<Id>,
+    pub(crate) starts: Vec<Cell>,
+    pub(crate) types: Vec<usize>,
+    pub(crate) targets: Vec<Target>,
+    /// Past looks: cells and sensor types, newest first.
+    pub(crate) history: Vec<Vec<(Cell, usize)>>,
+    pub(crate) horizon: usize,
+    pub(crate) estimator: EstimatorKind,
+    pub(crate) coordination: Coordination,
+    pub(crate) observed: Observed,
+    pub(crate) explain: bool,
+    pub(crate) min_separation: usize,
+    pub(crate) joint: JointSettings,
+}
+
+fn finite(field: impl Fn() -> String, v: f64) -> Result<f64, ValidationError> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(ValidationError::new(field(), "must be a finite number"))
+    }
+}
+
+impl PlanInput {
+    /// The sensors' cells now, in request order.
+    pub fn starts(&self) -> &[Cell] {
+        &self.starts
+    }
+
+    /// The sensors' types (indices into the scenario's), in request order.
+    pub fn types(&self) -> &[usize] {
+        &self.types
+    }
+
+    /// Validates a request against a scenario.
+    pub fn new(s: &Scenario, req: &PlanRequest) -> Result<Self, ValidationError> {
+        if req.sensors.is_empty() {
+            return Err(ValidationError::new(
+                "sensors",
+                "at least one sensor is required",
+            ));
+        }
+        if req.sensors.len() > MAX_SENSORS {
+            return Err(ValidationError::new(
+                "sensors",
+                format!("at most {MAX_SENSORS} sensors, got {}", req.sensors.len()),
+            ));
+        }
+        if req.targets.len() > MAX_TARGETS {
+            return Err(ValidationError::new(
+                "targets",
+                format!("at most {MAX_TARGETS} targets, got {}", req.targets.len()),
+            ));
+        }
+        let history = req.history.as_deref().unwrap_or(&[]);
+        if history.len() > MAX_HISTORY_STEPS {
+            return Err(ValidationError::new(
+                "history",
+                format!("at most {MAX_HISTORY_STEPS} steps, got {}", history.len()),
+            ));
+        }
+        // Field names are formatted only on error: a history holds thousands
+        // of positions.
+        let in_zone =
+            |field: &dyn Fn() -> String, x: f64, y: f64| -> Result<Cell, ValidationError> {
+                finite(|| format!("{}.x", field()), x)?;
+                finite(|| format!("{}.y", field()), y)?;
+                let p = Point::new(x, y);
+                if !s.in_zone(p) {
+                    return Err(ValidationError::new(
+                        field(),
+                        format!(
+                            "({x}, {y}) is outside the zone [0,{}]×[0,{}]",
+                            s.width, s.height
+                        ),
+                    ));
+                }
+                Ok(s.snap(p))
+            };
+        let type_of = |field: &dyn Fn() -> String, name: Option<&str>| {
+            let name = name.unwrap_or(DEFAULT_TYPE);
+            s.type_index(name).ok_or_else(|| {
+                let known: Vec<&str> = s.types.iter().map(|t| t.name.as_str()).collect();
+                ValidationError::new(
+                    format!("{}.type", field()),
+                    format!(
+                        "unknown sensor type {name:?}; the scenario has {}",
+                        known.join(", ")
+                    ),
+                )
+            })
+        };
+        let free = |field: &dyn Fn() -> String, c: Cell| {
+            if s.is_blocked(c) {
+                Err(ValidationError::new(
+                    field(),
+                    format!(
+                        "cell (col {}, row {}) is in a no-go zone: no sensor may stand on it",
+                        c.col, c.row
+                    ),
+                ))
+            } else {
+                Ok(c)
+            }
+        };
+        let mut seen = HashSet::new();
+        let mut ids = Vec::with_capacity(req.sensors.len());
+        let mut starts = Vec::with_capacity(req.sensors.len());
+        let mut types = Vec::with_capacity(req.sensors.len());
+        for (i, sensor) in req.sensors.iter().enumerate() {
+            if !seen.insert(sensor.id.key()) {
+                return Err(ValidationError::new(
+                    format!("sensors[{i}].id"),
+                    "duplicate sensor id",
+                ));
+            }
+            let field = || format!("sensors[{i}]");
+            types.push(type_of(&field, sensor.sensor_type.as_deref())?);
+            starts.push(free(&field, in_zone(&field, sensor.x, sensor.y)?)?);
+            ids.push(sensor.id.clone());
+        }
+        let mut targets = Vec::with_capacity(req.targets.len());
+        for (i, t) in req.targets.iter().enumerate() {
+            for (name, v) in [("x", t.x), ("y", t.y), ("vx", t.vx), ("vy", t.vy)] {
+                finite(|| format!("targets[{i}].{name}"), v)?;
+            }
+            targets.push(Target {
+                pos: Point::new(t.x, t.y),
+                vel: Point::new(t.vx, t.vy),
+            });
+        }
+        let mut past = Vec::with_capacity(history.len());
+        for (si, step) in history.iter().enumerate() {
+            if step.len() > MAX_HISTORY_POSITIONS {
+                return Err(ValidationError::new(
+                    format!("history[{si}]"),
+                    format!(
+                        "at most {MAX_HISTORY_POSITIONS} positions per step, got {}",
+                        step.len()
+                    ),
+                ));
+            }
+            past.push(
+                step.iter()
+                    .enumerate()
+                    .map(|(pi, p)| {
+                        let field = || format!("history[{si}][{pi}]");
+                        let ty = type_of(&field, p.sensor_type.as_deref())?;
+                        Ok((free(&field, in_zone(&field, p.x, p.y)?)?, ty))
+                    })
+                    .collect::<Result<Vec<_>, ValidationError>>()?,
+            );
+        }
+        let horizon = check_horizon("horizon", req.horizon.as_ref(), s.horizon)?;
+        let min_separation = check_min_separation("min_separation", req.min_separation.as_ref())?
+            .unwrap_or(s.min_separation);
+        let mut joint = JointSettings::default();
+        if let Some(g) = req.gap_target {
+            if !(0.0..=1.0).contains(&g) {
+                return Err(ValidationError::new(
+                    "gap_target",
+                    format!("must be a number in [0, 1], got {g}"),
+                ));
+            }
+            joint.gap_target = g;
+        }
+        if let Some(b) = &req.budget_ms {
+            let ms = b.check("budget_ms", 1..=MAX_BUDGET_MS as usize)?;
+            joint.budget = std::time::Duration::from_millis(ms as u64);
+        }
+        Ok(PlanInput {
+            min_separation,
+            ids,
+            starts,
+            types,
+            targets,
+            history: past,
+            horizon,
+            estimator: req.estimator.unwrap_or_default(),
+            coordination: req.coordination.unwrap_or_default(),
+            observed: req.observed.unwrap_or_default(),
+            explain: req.explain.unwrap_or(false),
+            joint,
+        })
+    }
+}

@@ -1,0 +1,344 @@
+//! The [`Planner`] of one scenario: its statistics, computed once, and
+//! [`Planner::plan`], which turns a validated request into coordinated
+//! T-step paths.
+
+use std::collections::HashSet;
+use std::time::Instant;
+
+use super::input::PlanInput;
+use super::wire::*;
+use crate::cancel::{CancelToken, Cancelled, Progress};
+use crate::coordination::{Fleet, coordinate};
+use crate::estimator::{ElementaryGrid, Estimator, ExactEstimator, PaperEstimator, SourceRays};
+use crate::scenario::{Cell, Look, Scenario, ValidationError};
+use crate::stats::Stats;
+
+/// A scenario with its precomputed statistics, ready to plan.
+#[derive(Debug)]
+pub struct Planner {
+    /// The scenario.
+    pub scenario: Scenario,
+    /// Its per-cell statistics, per field of view (the scenario's `fovs`;
+    /// `stats[0]` is the type `default`'s).
+    pub stats: Vec<Stats>,
+    pub(crate) rays: Vec<SourceRays>,
+    pub(crate) grid: Option<ElementaryGrid>,
+    /// Time the precomputation took, milliseconds.
+    pub precompute_ms: f64,
+}
+
+impl Planner {
+    /// Precomputes the statistics of a scenario.
+    pub fn new(scenario: Scenario) -> Self {
+        match Self::precompute(scenario, &CancelToken::never(), &Progress::default()) {
+            Ok(planner) => planner,
+            Err(Cancelled) => unreachable!("work that is never cancelled finishes"),
+        }
+    }
+
+    /// [`Planner::new`], in blocks of cells (see
+    /// [`Stats::for_fov_cancellable`]) that check `cancel` and advance
+    /// `progress`; the indexing of rays that follows is one more block.
+    /// The planner is the same as [`Planner::new`]'s.
+    ///
+    /// # Errors
+    /// [`Cancelled`] once `cancel` is cancelled.
+    pub fn precompute(
+        scenario: Scenario,
+        cancel: &CancelToken,
+        progress: &Progress,
+    ) -> Result<Self, Cancelled> {
+        let started = Instant::now();
+        progress.add_total(scenario.fovs.len() * Stats::blocks(&scenario) + 1);
+        let stats = scenario
+            .fovs
+            .iter()
+            .map(|&fov| Stats::for_fov_cancellable(&scenario, fov, cancel, progress))
+            .collect::<Result<Vec<_>, _>>()?;
+        cancel.check()?;
+        let mut rays = SourceRays::for_scenario(&scenario);
+        let grid = ElementaryGrid::new(&scenario);
+        if let Some(grid) = &grid {
+            SourceRays::index_crossings(&mut rays, &scenario, grid);
+        }
+        SourceRays::index_looks(&mut rays, &scenario);
+        progress.advance(1);
+        Ok(Planner {
+            scenario,
+            stats,
+            rays,
+            grid,
+            precompute_ms: started.elapsed().as_secs_f64() * 1e3,
+        })
+    }
+
+    /// The statistics of the sensor type `ty`'s field of view.
+    pub fn stats_of(&self, ty: usize) -> &Stats {
+        &self.stats[self.scenario.types[ty].fov_slot]
+    }
+
+    /// Approximate heap memory held, bytes (for cache bounds).
+    pub fn memory_bytes(&self) -> usize {
+        let cells = self.scenario.cell_count();
+        let blocked = if self.scenario.has_no_go() { cells } else { 0 };
+        let stats = 3 * self.stats.len() * cells * std::mem::size_of::<f64>() + blocked;
+        let grid = self.grid.as_ref().map_or(0, ElementaryGrid::memory_bytes);
+        let rays: usize = self.rays.iter().map(SourceRays::memory_bytes).sum();
+        std::mem::size_of::<Self>() + stats + grid + rays
+    }
+
+    /// Validates and plans a request.
+    pub fn plan_request(&self, req: &PlanRequest) -> Result<PlanResponse, ValidationError> {
+        Ok(self.plan(&PlanInput::new(&self.scenario, req)?))
+    }
+
+    /// Validates a request and plans it unless `cancel` is cancelled
+    /// first (see [`Planner::plan_cancellable`]).
+    ///
+    /// # Errors
+    /// The outer error for an invalid request, the inner one when the work
+    /// was cancelled.
+    pub fn plan_request_cancellable(
+        &self,
+        req: &PlanRequest,
+        cancel: &CancelToken,
+    ) -> Result<Result<PlanResponse, Cancelled>, ValidationError> {
+        Ok(self.plan_cancellable(&PlanInput::new(&self.scenario, req)?, cancel))
+    }
+
+    /// Plans a validated request.
+    ///
+    /// Runs on a worker of rayon's global pool (moving there first when
+    /// called from outside it), so the plan's parallel parts split among
+    /// the workers without handing work back and forth between threads.
+    /// With a global pool of one thread (one core) it runs where it is
+    /// called instead ([`Planner::plan_here`]): the same answer, without
+    /// the two thread switches of the move.
+    pub fn plan(&self, input: &PlanInput) -> PlanResponse {
+        match self.plan_cancellable(input, &CancelToken::never()) {
+            Ok(response) => response,
+            Err(Cancelled) => unreachable!("a plan that is never cancelled finishes"),
+        }
+    }
+
+    /// [`Planner::plan`], checking `cancel` between its stages and within
+    /// the search and coordination (see [`coordinate`]), so a cancelled plan
+    /// stops within one sensor-step's fill.
+    ///
+    /// # Errors
+    /// [`Cancelled`] once `cancel` is cancelled.
+    pub fn plan_cancellable(
+        &self,
+        input: &PlanInput,
+        cancel: &CancelToken,
+    ) -> Result<PlanResponse, Cancelled> {
+        if rayon::current_thread_index().is_none() && rayon::current_num_threads() > 1 {
+            return rayon::scope(|_| self.plan_here(input, cancel));
+        }
+        self.plan_here(input, cancel)
+    }
+
+    /// [`Planner::plan_cancellable`] on the calling thread: on a worker of
+    /// a rayon pool the plan's parallel parts split among its workers; on
+    /// any other thread they run there, one after the other. The answer is
+    /// the same to the last bit either way. For a pool of one thread this
+    /// saves the two thread switches of the hop to it and back.
+    ///
+    /// # Errors
+    /// [`Cancelled`] once `cancel` is cancelled.
+    pub fn plan_here(
+        &self,
+        input: &PlanInput,
+        cancel: &CancelToken,
+    ) -> Result<PlanResponse, Cancelled> {
+        cancel.check()?;
+        let started = Instant::now();
+        let s = &self.scenario;
+        let est = self.estimator(input, cancel)?;
+        cancel.check()?;
+        let fleet = Fleet::new(
+            s,
+            est.as_ref(),
+            &input.starts,
+            &input.types,
+            input.horizon,
+            input.min_separation,
+            cancel,
+        );
+        let result = coordinate(&fleet, input.coordination, input.joint, started)?;
+        let cell_out = |c: Cell| {
+            let p = s.centre(c);
+            CellOut {
+                col: c.col,
+                row: c.row,
+                x: p.x,
+                y: p.y,
+            }
+        };
+        let mut rank = vec![0; input.starts.len()];
+        for (r, &i) in result.order.iter().enumerate() {
+            rank[i] = r + 1;
+        }
+        let plans = result
+            .plans
+            .iter()
+            .enumerate()
+            .map(|(i, p)| PlanOut {
+                sensor: input.ids[i].clone(),
+                priority: rank[i],
+                start: cell_out(input.starts[i]),
+                path: p.path.iter().map(|&c| cell_out(c)).collect(),
+                expected_detections: p.value,
+                separation_violations: result.violations.per_sensor[i],
+                explain: input.explain.then(|| Explain {
+                    values: p.grid.to_nested(),
+                }),
+            })
+            .collect();
+        Ok(PlanResponse {
+            scenario: s.id.clone(),
+            horizon: input.horizon,
+            estimator: input.estimator,
+            coordination: input.coordination,
+            min_separation: input.min_separation,
+            separation_violations: result.violations.pairs,
+            plans,
+            expected_detections: result.by_step.iter().sum(),
+            expected_by_step: result.by_step,
+            bound: result.bound,
+            joint: result.joint,
+            compute_micros: started.elapsed().as_micros() as u64,
+        })
+    }
+
+    /// The estimator `input` asks for, prepared for its sensors, targets
+    /// and looks.
+    ///
+    /// # Errors
+    /// [`Cancelled`] once `cancel` is cancelled.
+    pub(crate) fn estimator(
+        &self,
+        input: &PlanInput,
+        cancel: &CancelToken,
+    ) -> Result<Box<dyn Estimator + '_>, Cancelled> {
+        let s = &self.scenario;
+        Ok(match input.estimator {
+            EstimatorKind::Paper => Box::new(PaperEstimator::new(
+                s,
+                &self.stats,
+                &input.starts,
+                &input.types,
+                &input.targets,
+                input.horizon,
+            )),
+            EstimatorKind::Exact => {
+                let observed = self.observed_looks(input);
+                let est = ExactEstimator::new(
+                    s,
+                    &self.stats,
+                    &self.rays,
+                    self.grid.as_ref(),
+                    &observed,
+                    &input.targets,
+                    &input.starts,
+                    &input.types,
+                    input.horizon,
+                );
+                cancel.check()?;
+                est.prepare();
+                Box::new(est)
+            }
+        })
+    }
+
+    /// `O_s` for s = 0, 1, …: the looks taken now and in the history (the
+    /// whole zone, certain, now when the caller reports every target in it).
+    fn observed_looks(&self, input: &PlanInput) -> Vec<Vec<Look>> {
+        let s = &self.scenario;
+        let now = match input.observed {
+            Observed::Zone => vec![Look::certain(s.zone_region())],
+            Observed::Sensors => dedup(
+                input
+                    .starts
+                    .iter()
+                    .copied()
+                    .zip(input.types.iter().copied()),
+            )
+            .into_iter()
+            .map(|(c, ty)| s.look(ty, c))
+            .collect(),
+        };
+        std::iter::once(now)
+            .chain(input.history.iter().map(|step| {
+                dedup(step.iter().copied())
+                    .into_iter()
+                    .map(|(c, ty)| s.look(ty, c))
+                    .collect()
+            }))
+            .collect()
+    }
+}
+
+/// The looks (cell and type) without repeats, in their order (the
+/// estimator reads the i-th position of each step as one sensor's track).
+/// Two sensors of the same type on one cell take one look: they see the
+/// same targets at once.
+fn dedup(looks: impl Iterator<Item = (Cell, usize)>) -> Vec<(Cell, usize)> {
+    // As many as come, as a rule: one allocation, not one per doubling.
+    let mut kept: Vec<(Cell, usize)> = Vec::with_capacity(looks.size_hint().0);
+    let mut seen = HashSet::new();
+    for look in looks {
+        // A scan for a fleet's few looks (a hash per look cost 2 % of a
+        // plan), a set past that.
+        let new = if kept.len() < 64 {
+            !kept.contains(&look)
+        } else {
+            if seen.is_empty() {
+                seen.extend(kept.iter().copied());
+            }
+            seen.insert(look)
+        };
+        if new {
+            kept.push(look);
+        }
+    }
+    kept
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Id;
+
+    #[test]
+    fn ids_are_strings_or_numbers_echoed_as_given() {
+        for text in [
+            r#""a""#,
+            r#""7""#,
+            "7",
+            "-3",
+            "1.5",
+            "18446744073709551615",
+            "1e3",
+        ] {
+            let id: Id = serde_json::from_str(text).expect(text);
+            let back = serde_json::to_string(&id).expect("serializes");
+            let again: Id = serde_json::from_str(&back).expect("parses back");
+            assert_eq!(again, id, "{text}");
+            // Parsed the way `serde_json` reads the same token.
+            assert_eq!(
+                serde_json::to_value(&id).expect("value"),
+                serde_json::from_str::<serde_json::Value>(text).expect("value"),
+                "{text}"
+            );
+        }
+        assert!(matches!(
+            serde_json::from_str::<Id>(r#""7""#),
+            Ok(Id::Text(_))
+        ));
+        assert!(matches!(serde_json::from_str::<Id>("7"), Ok(Id::Number(_))));
+        for bad in ["true", "null", "[1]", r#"{"a":1}"#] {
+            let err = serde_json::from_str::<Id>(bad).expect_err(bad);
+            assert!(err.to_string().contains("a string or a number"), "{err}");
+        }
+    }
+}

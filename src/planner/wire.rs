@@ -1,0 +1,287 @@
+//! The planning API's request and response types, shared by the HTTP layer
+//! and in-process callers: what clients send ([`PlanRequest`]) and what they
+//! get back ([`PlanResponse`]).
+
+use serde::{Deserialize, Serialize};
+use utoipa::ToSchema;
+
+use crate::coordination::{Bound, Coordination, JointReport};
+use crate::scenario::Integer;
+
+/// Which estimator of `n̂(k,t)` to use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum EstimatorKind {
+    /// The conditional expectation under the model (ours).
+    #[default]
+    Exact,
+    /// Equations (1) and (2) of the paper.
+    Paper,
+}
+
+/// What the reported targets cover.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum Observed {
+    /// The targets inside the sensors' fields of view (now and in the history).
+    #[default]
+    Sensors,
+    /// Every target in the zone (a clairvoyant reference).
+    Zone,
+}
+
+/// A sensor or target id: a string or a number, echoed back as given.
+#[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+#[serde(untagged)]
+#[schema(examples("a", 7))]
+pub enum Id {
+    /// A string id.
+    Text(String),
+    /// A numeric id.
+    #[schema(value_type = f64)]
+    Number(serde_json::Number),
+}
+
+/// By hand rather than `untagged`, which buffers every id and, for a
+/// number, first fails (an error message formatted and dropped) as a string.
+impl<'de> Deserialize<'de> for Id {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct IdVisitor;
+        impl serde::de::Visitor<'_> for IdVisitor {
+            type Value = Id;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a string or a number")
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Id, E> {
+                Ok(Id::Text(v.to_owned()))
+            }
+            fn visit_string<E: serde::de::Error>(self, v: String) -> Result<Id, E> {
+                Ok(Id::Text(v))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Id, E> {
+                Ok(Id::Number(v.into()))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Id, E> {
+                Ok(Id::Number(v.into()))
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Id, E> {
+                serde_json::Number::from_f64(v)
+                    .map(Id::Number)
+                    .ok_or_else(|| E::custom("an id must be a finite number"))
+            }
+        }
+        deserializer.deserialize_any(IdVisitor)
+    }
+}
+
+impl std::fmt::Display for Id {
+    /// As in JSON: a string quoted, a number as given.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Id::Text(s) => write!(f, "{s:?}"),
+            Id::Number(n) => write!(f, "{n}"),
+        }
+    }
+}
+
+impl Id {
+    /// A key that tells ids apart: `"7"` and `7` are two ids.
+    pub(crate) fn key(&self) -> String {
+        match self {
+            Id::Text(s) => format!("s:{s}"),
+            Id::Number(n) => format!("n:{n}"),
+        }
+    }
+}
+
+/// A sensor's current position.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(examples(json!({"id": "d1", "x": 155.0, "y": 145.0, "type": "drone"})))]
+pub struct SensorIn {
+    /// Unique id.
+    pub id: Id,
+    /// East coordinate.
+    pub x: f64,
+    /// North coordinate.
+    pub y: f64,
+    /// Its sensor type (a name of the scenario's `sensor_types`);
+    /// `default` by default.
+    #[serde(rename = "type", default, skip_serializing_if = "Option::is_none")]
+    #[schema(max_length = 32)]
+    pub sensor_type: Option<String>,
+}
+
+/// A reported target.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct TargetIn {
+    /// Optional id.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub id: Option<Id>,
+    /// East coordinate now.
+    pub x: f64,
+    /// North coordinate now.
+    pub y: f64,
+    /// East displacement per step.
+    pub vx: f64,
+    /// North displacement per step.
+    pub vy: f64,
+}
+
+/// A past sensor position: a look taken then.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PositionIn {
+    /// East coordinate.
+    pub x: f64,
+    /// North coordinate.
+    pub y: f64,
+    /// The type of the sensor that stood there (its field of view and
+    /// `p_detect`); `default` by default.
+    #[serde(rename = "type", default, skip_serializing_if = "Option::is_none")]
+    #[schema(max_length = 32)]
+    pub sensor_type: Option<String>,
+}
+
+impl PositionIn {
+    /// A position of a `default` sensor.
+    pub fn at(x: f64, y: f64) -> Self {
+        PositionIn {
+            x,
+            y,
+            sensor_type: None,
+        }
+    }
+}
+
+/// Body of `POST /v1/scenarios/{id}/plan`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PlanRequest {
+    /// Sensors now.
+    #[schema(min_items = 1, max_items = 256)]
+    pub sensors: Vec<SensorIn>,
+    /// Targets reported now.
+    #[serde(default)]
+    #[schema(max_items = 20000)]
+    pub targets: Vec<TargetIn>,
+    /// Sensors' positions 1, 2, … steps ago (at most 256 a step).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(max_items = 32)]
+    pub history: Option<Vec<Vec<PositionIn>>>,
+    /// Horizon T; the scenario's by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<u32>, minimum = 1, maximum = 12)]
+    pub horizon: Option<Integer>,
+    /// Estimator; `exact` by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub estimator: Option<EstimatorKind>,
+    /// Coordination; `priority` by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coordination: Option<Coordination>,
+    /// What the reported targets cover; `sensors` by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub observed: Option<Observed>,
+    /// Include the search values in the response.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub explain: Option<bool>,
+    /// Minimum separation between sensors at every step of the plan,
+    /// cells (Chebyshev distance; 0..=16, 0 = no rule); the scenario's by
+    /// default. Kept wherever it can be: a sensor that cannot keep it (it
+    /// starts too close to another, or is cornered) takes the path with the
+    /// fewest violations, which the response counts.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<u32>, minimum = 0, maximum = 16)]
+    pub min_separation: Option<Integer>,
+    /// With `coordination: joint`: the certified gap at which it stops, in
+    /// `[0, 1]`; 0.001 by default. Other coordinations ignore it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(minimum = 0.0, maximum = 1.0)]
+    pub gap_target: Option<f64>,
+    /// With `coordination: joint`: the most time the plan may take,
+    /// milliseconds (1..=1000, 20 by default), counted from its start and
+    /// within the server's time limit. Other coordinations ignore it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<u32>, minimum = 1, maximum = 1000)]
+    pub budget_ms: Option<Integer>,
+}
+
+/// A lattice cell and its centre.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, ToSchema)]
+pub struct CellOut {
+    /// Column.
+    pub col: i32,
+    /// Row.
+    pub row: i32,
+    /// Centre, east.
+    pub x: f64,
+    /// Centre, north.
+    pub y: f64,
+}
+
+/// The search values of one sensor.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
+pub struct Explain {
+    /// `values[t−1][dr+m·T][dc+m·T]` (m the sensor's speed); null where
+    /// unreachable by step t, blocked or off the lattice.
+    pub values: Vec<Vec<Vec<Option<f64>>>>,
+}
+
+/// One sensor's plan.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
+pub struct PlanOut {
+    /// The sensor's id.
+    pub sensor: Id,
+    /// Rank, 1 = highest.
+    pub priority: usize,
+    /// The cell it starts from.
+    pub start: CellOut,
+    /// Cells at steps 1..=T.
+    pub path: Vec<CellOut>,
+    /// The value its final search maximised.
+    pub expected_detections: f64,
+    /// The (step, other sensor) pairs at which its path is closer to
+    /// another sensor's than `min_separation` allows.
+    pub separation_violations: u32,
+    /// Search values, when asked for.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub explain: Option<Explain>,
+}
+
+/// Response of a plan request.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
+pub struct PlanResponse {
+    /// Scenario id.
+    pub scenario: String,
+    /// Horizon T used.
+    pub horizon: usize,
+    /// Estimator used.
+    pub estimator: EstimatorKind,
+    /// Coordination used.
+    pub coordination: Coordination,
+    /// Minimum separation kept, cells (0: none).
+    pub min_separation: usize,
+    /// The (step, pair of sensors) at which two paths are closer than
+    /// `min_separation` allows, each pair once per step (half the sum of
+    /// the plans' counts).
+    pub separation_violations: u32,
+    /// Plans in request order.
+    pub plans: Vec<PlanOut>,
+    /// Expected distinct targets detected over steps 1..=T.
+    pub expected_detections: f64,
+    /// The same per step.
+    pub expected_by_step: Vec<f64>,
+    /// With the `exact` estimator: an upper bound on what the best joint
+    /// plan could expect, and how far this plan may be from it (see the
+    /// README's "certified plan quality"). Absent for `paper`, whose total
+    /// is not a coverage.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bound: Option<Bound>,
+    /// With `coordination: joint` and the `exact` estimator: its rounds
+    /// after `iterated`, why it stopped and the time it used.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joint: Option<JointReport>,
+    /// Planning time, microseconds.
+    pub compute_micros: u64,
+}
