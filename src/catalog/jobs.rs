@@ -21,13 +21,18 @@ pub struct JobLimits {
     pub queue: usize,
 }
 
+impl JobLimits {
+    /// The defaults, which `vigil-server`'s flags also start from.
+    pub const DEFAULT: JobLimits = JobLimits {
+        sync_precompute_ms: 1000.0,
+        jobs: 1,
+        queue: 16,
+    };
+}
+
 impl Default for JobLimits {
     fn default() -> Self {
-        Self {
-            sync_precompute_ms: 1000.0,
-            jobs: 1,
-            queue: 16,
-        }
+        Self::DEFAULT
     }
 }
 

@@ -5,6 +5,7 @@ use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::time::Duration;
 
+use super::serve::ConnLimits;
 use crate::catalog::JobLimits;
 
 /// Log output format.
@@ -60,50 +61,54 @@ pub struct Config {
     pub log_format: LogFormat,
     /// Most /v1 requests handled at once; past it, requests are shed at once
     /// with 503 and Retry-After.
-    #[arg(long, env = "VIGIL_MAX_IN_FLIGHT", default_value_t = 64)]
+    #[arg(long, env = "VIGIL_MAX_IN_FLIGHT", default_value_t = Settings::DEFAULT.max_in_flight)]
     pub max_in_flight: usize,
     /// Time limit of a /v1 request, milliseconds (504 past it).
-    #[arg(long, env = "VIGIL_REQUEST_TIMEOUT_MS", default_value_t = 30_000)]
+    #[arg(long, env = "VIGIL_REQUEST_TIMEOUT_MS",
+        default_value_t = Settings::DEFAULT.request_timeout.as_millis() as u64)]
     pub request_timeout_ms: u64,
     /// Memory for statistics of scenarios planned inline through /v1/plan,
     /// MiB (least recently used are evicted); with --database-url, as much
     /// again for the registered scenarios this replica uses.
-    #[arg(long, env = "VIGIL_CACHE_MB", default_value_t = 512)]
+    #[arg(long, env = "VIGIL_CACHE_MB", default_value_t = (Settings::DEFAULT.cache_bytes >> 20) as u64)]
     pub cache_mb: u64,
     /// A connection that has not sent a whole request head within this
     /// many milliseconds (of opening, or of its first byte after idling)
     /// is closed.
-    #[arg(long, env = "VIGIL_HEADER_TIMEOUT_MS", default_value_t = 10_000)]
+    #[arg(long, env = "VIGIL_HEADER_TIMEOUT_MS",
+        default_value_t = ConnLimits::DEFAULT.header_timeout.as_millis() as u64)]
     pub header_timeout_ms: u64,
     /// A keep-alive connection idle for this many milliseconds is closed.
-    #[arg(long, env = "VIGIL_IDLE_TIMEOUT_MS", default_value_t = 60_000)]
+    #[arg(long, env = "VIGIL_IDLE_TIMEOUT_MS",
+        default_value_t = ConnLimits::DEFAULT.idle_timeout.as_millis() as u64)]
     pub idle_timeout_ms: u64,
     /// Most connections open at once; past it a new connection is closed at
     /// once, and the open ones are served as usual.
-    #[arg(long, env = "VIGIL_MAX_CONNECTIONS", default_value_t = 10_000)]
+    #[arg(long, env = "VIGIL_MAX_CONNECTIONS", default_value_t = ConnLimits::DEFAULT.max_connections)]
     pub max_connections: usize,
     /// A scenario whose precomputation is predicted to take longer than
     /// this many milliseconds is registered as a background job (202), and
     /// refused inline in /v1/plan (422).
-    #[arg(long, env = "VIGIL_SYNC_PRECOMPUTE_MS", default_value_t = 1_000)]
+    #[arg(long, env = "VIGIL_SYNC_PRECOMPUTE_MS",
+        default_value_t = JobLimits::DEFAULT.sync_precompute_ms as u64)]
     pub sync_precompute_ms: u64,
     /// Precomputation jobs running at once.
-    #[arg(long, env = "VIGIL_PRECOMPUTE_JOBS", default_value_t = 1)]
+    #[arg(long, env = "VIGIL_PRECOMPUTE_JOBS", default_value_t = JobLimits::DEFAULT.jobs)]
     pub precompute_jobs: usize,
     /// Precomputation jobs waiting at most; past it a registration that
     /// would be a job gets 503.
-    #[arg(long, env = "VIGIL_PRECOMPUTE_QUEUE", default_value_t = 16)]
+    #[arg(long, env = "VIGIL_PRECOMPUTE_QUEUE", default_value_t = JobLimits::DEFAULT.queue)]
     pub precompute_queue: usize,
     /// A plan predicted to take more than this many milliseconds of CPU is
     /// refused with 422 before any work starts (0: no limit).
-    #[arg(long, env = "VIGIL_MAX_PLAN_MS", default_value_t = 2_000)]
+    #[arg(long, env = "VIGIL_MAX_PLAN_MS", default_value_t = DEFAULT_MAX_PLAN_MS)]
     pub max_plan_ms: u64,
     /// A session without a request for this many seconds is dropped.
-    #[arg(long, env = "VIGIL_SESSION_TTL_S", default_value_t = 600)]
+    #[arg(long, env = "VIGIL_SESSION_TTL_S", default_value_t = Settings::DEFAULT.session_ttl.as_secs())]
     pub session_ttl_s: u64,
     /// Most sessions held at once; past it the least recently used is
     /// dropped.
-    #[arg(long, env = "VIGIL_MAX_SESSIONS", default_value_t = 10_000)]
+    #[arg(long, env = "VIGIL_MAX_SESSIONS", default_value_t = Settings::DEFAULT.max_sessions)]
     pub max_sessions: usize,
 }
 
@@ -119,8 +124,8 @@ impl Config {
     }
 
     /// The limits on connections.
-    pub fn conn_limits(&self) -> super::serve::ConnLimits {
-        super::serve::ConnLimits {
+    pub fn conn_limits(&self) -> ConnLimits {
+        ConnLimits {
             header_timeout: Duration::from_millis(self.header_timeout_ms.max(1)),
             idle_timeout: Duration::from_millis(self.idle_timeout_ms.max(1)),
             max_connections: self.max_connections.max(1),
@@ -129,7 +134,7 @@ impl Config {
 }
 
 /// The settings the router needs.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Settings {
     /// Required bearer key of /v1 endpoints.
     pub api_key: Option<String>,
@@ -185,22 +190,31 @@ impl Settings {
     }
 }
 
+/// The most predicted CPU milliseconds of one plan by default
+/// (`--max-plan-ms`; 0 there means no limit).
+pub const DEFAULT_MAX_PLAN_MS: u64 = 2_000;
+
+impl Settings {
+    /// The defaults, which `vigil-server`'s flags also start from.
+    pub const DEFAULT: Settings = Settings {
+        api_key: None,
+        cors_origins: Vec::new(),
+        max_in_flight: 64,
+        request_timeout: Duration::from_secs(30),
+        cache_bytes: 512 << 20,
+        sync_precompute_ms: JobLimits::DEFAULT.sync_precompute_ms,
+        precompute_jobs: JobLimits::DEFAULT.jobs,
+        precompute_queue: JobLimits::DEFAULT.queue,
+        max_plan_ms: Some(DEFAULT_MAX_PLAN_MS as f64),
+        session_ttl: Duration::from_secs(600),
+        max_sessions: 10_000,
+        inline_plans: None,
+    };
+}
+
 impl Default for Settings {
     fn default() -> Self {
-        Settings {
-            api_key: None,
-            cors_origins: Vec::new(),
-            max_in_flight: 64,
-            request_timeout: Duration::from_secs(30),
-            cache_bytes: 512 << 20,
-            sync_precompute_ms: 1000.0,
-            precompute_jobs: 1,
-            precompute_queue: 16,
-            max_plan_ms: Some(2000.0),
-            session_ttl: Duration::from_secs(600),
-            max_sessions: 10_000,
-            inline_plans: None,
-        }
+        Self::DEFAULT
     }
 }
 
@@ -225,5 +239,20 @@ impl From<&Config> for Settings {
             max_sessions: c.max_sessions.max(1),
             inline_plans: None,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::Parser;
+
+    use super::{Config, ConnLimits, Settings};
+
+    /// The flags start from the same defaults as the types they fill.
+    #[test]
+    fn flag_defaults_are_the_types_defaults() {
+        let config = Config::parse_from(["vigil-server"]);
+        assert_eq!(Settings::from(&config), Settings::default());
+        assert_eq!(config.conn_limits(), ConnLimits::default());
     }
 }

@@ -47,13 +47,18 @@ pub struct ConnLimits {
     pub max_connections: usize,
 }
 
+impl ConnLimits {
+    /// The defaults, which `vigil-server`'s flags also start from.
+    pub const DEFAULT: ConnLimits = ConnLimits {
+        header_timeout: Duration::from_secs(10),
+        idle_timeout: Duration::from_secs(60),
+        max_connections: 10_000,
+    };
+}
+
 impl Default for ConnLimits {
     fn default() -> Self {
-        ConnLimits {
-            header_timeout: Duration::from_secs(10),
-            idle_timeout: Duration::from_secs(60),
-            max_connections: 10_000,
-        }
+        Self::DEFAULT
     }
 }
 
