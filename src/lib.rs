@@ -30,6 +30,7 @@ pub mod evaluate;
 pub mod geometry;
 pub mod http;
 pub mod limits;
+pub mod metric_names;
 mod parallel;
 pub mod planner;
 pub mod scenario;

@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use crate::cancel::{CancelToken, Cancelled, Progress};
 use crate::cost;
+use crate::metric_names;
 use crate::planner::Planner;
 use crate::scenario::Scenario;
 
@@ -107,7 +108,7 @@ pub(super) fn precompute_on(
         Some(pool) => pool.install(|| Planner::precompute(scenario, cancel, progress)),
         None => Planner::precompute(scenario, cancel, progress),
     }?;
-    metrics::histogram!("vigil_precompute_seconds").record(planner.precompute_ms / 1e3);
+    metrics::histogram!(metric_names::PRECOMPUTE_SECONDS).record(planner.precompute_ms / 1e3);
     Ok(planner)
 }
 

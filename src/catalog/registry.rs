@@ -37,6 +37,7 @@ use super::jobs::{
     Entry, Job, JobLimits, JobStatus, Pool, entry_id, precompute, precompute_on,
     predicted_precompute_ms,
 };
+use crate::metric_names;
 use crate::planner::Planner;
 use crate::scenario::{BUILTIN_IDS, Scenario, builtins};
 use crate::store::{DbError, PgStore, Store};
@@ -233,9 +234,11 @@ impl Registry {
 
     fn update_gauges(&self, state: &State) {
         let cached = self.shared.db.as_ref().map_or(0, |db| db.cache.usage().0);
-        metrics::gauge!("vigil_scenarios_loaded").set((state.scenarios.len() + cached) as f64);
-        metrics::gauge!("vigil_precompute_jobs", "state" => "queued").set(state.queue.len() as f64);
-        metrics::gauge!("vigil_precompute_jobs", "state" => "running")
+        metrics::gauge!(metric_names::SCENARIOS_LOADED)
+            .set((state.scenarios.len() + cached) as f64);
+        metrics::gauge!(metric_names::PRECOMPUTE_JOBS, "state" => "queued")
+            .set(state.queue.len() as f64);
+        metrics::gauge!(metric_names::PRECOMPUTE_JOBS, "state" => "running")
             .set(state.running.len() as f64);
     }
 
@@ -709,7 +712,7 @@ impl Registry {
             if let Entry::Pending(job) = &removed {
                 job.cancel.cancel();
                 state.queue.retain(|j| !Arc::ptr_eq(j, job));
-                metrics::counter!("vigil_cancelled_total", "kind" => "precompute", "reason" => "deleted")
+                metrics::counter!(metric_names::CANCELLED_TOTAL, "kind" => "precompute", "reason" => "deleted")
                     .increment(1);
             }
         }

@@ -15,6 +15,7 @@ use super::state::AppState;
 use crate::coordination::Coordination;
 use crate::cost;
 use crate::evaluate::{EvaluateInput, EvaluateRequest, EvaluateResponse};
+use crate::metric_names;
 use crate::planner::Planner;
 
 /// Validates `req`, refuses it past the plan cost limit, and scores it on
@@ -34,7 +35,7 @@ async fn evaluate_admitted(
     if let Some(limit_ms) = state.settings.max_plan_ms
         && predicted_ms > limit_ms
     {
-        metrics::counter!("vigil_plans_refused_total", "reason" => "cost").increment(1);
+        metrics::counter!(metric_names::PLANS_REFUSED_TOTAL, "reason" => "cost").increment(1);
         return Err(ApiError::PlanTooCostly {
             predicted_ms,
             limit_ms,

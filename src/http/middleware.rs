@@ -14,6 +14,7 @@ use tower::BoxError;
 
 use super::error::ApiError;
 use super::state::AppState;
+use crate::metric_names;
 
 /// Requires `Authorization: Bearer <key>` when an API key is configured;
 /// the key is compared in constant time.
@@ -38,7 +39,7 @@ pub async fn require_key(State(state): State<AppState>, req: Request, next: Next
 /// Retry-After, an expired one 504.
 pub async fn overload_error(err: BoxError) -> ApiError {
     if err.is::<tower::load_shed::error::Overloaded>() {
-        metrics::counter!("vigil_http_shed_total").increment(1);
+        metrics::counter!(metric_names::HTTP_SHED_TOTAL).increment(1);
         ApiError::Overloaded
     } else if err.is::<tower::timeout::error::Elapsed>() {
         ApiError::Timeout
@@ -82,15 +83,15 @@ pub async fn track(mut req: Request, next: Next) -> Response {
     let method = req.method().to_string();
     let started = Instant::now();
     req.extensions_mut().insert(RequestStart(started));
-    metrics::gauge!("vigil_http_requests_in_flight").increment(1.0);
+    metrics::gauge!(metric_names::HTTP_REQUESTS_IN_FLIGHT).increment(1.0);
     let res = next.run(req).await;
-    metrics::gauge!("vigil_http_requests_in_flight").decrement(1.0);
+    metrics::gauge!(metric_names::HTTP_REQUESTS_IN_FLIGHT).decrement(1.0);
     let status = res.status().as_u16().to_string();
     if route.ends_with("/plan") || route.ends_with("/step") {
-        metrics::histogram!("vigil_plan_duration_seconds", "route" => route.clone())
+        metrics::histogram!(metric_names::PLAN_DURATION_SECONDS, "route" => route.clone())
             .record(started.elapsed().as_secs_f64());
     }
-    metrics::counter!("vigil_http_requests_total", "method" => method, "route" => route, "status" => status)
+    metrics::counter!(metric_names::HTTP_REQUESTS_TOTAL, "method" => method, "route" => route, "status" => status)
         .increment(1);
     res
 }

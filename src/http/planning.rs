@@ -15,6 +15,7 @@ use super::state::AppState;
 use crate::cancel::{CancelToken, Progress};
 use crate::catalog::{CatalogError, precompute_cancellable, predicted_precompute_ms};
 use crate::cost;
+use crate::metric_names;
 use crate::planner::{PlanInput, PlanRequest, PlanResponse, Planner};
 use crate::scenario::{Scenario, ScenarioSpec};
 
@@ -68,7 +69,7 @@ impl Drop for CancelOnDrop {
             .start
             .is_some_and(|RequestStart(t)| t.elapsed() >= self.timeout);
         let reason = if timed_out { "timeout" } else { "client_gone" };
-        metrics::counter!("vigil_cancelled_total", "kind" => self.kind, "reason" => reason)
+        metrics::counter!(metric_names::CANCELLED_TOTAL, "kind" => self.kind, "reason" => reason)
             .increment(1);
     }
 }
@@ -88,7 +89,7 @@ pub(super) async fn plan_admitted(
     if let Some(limit_ms) = state.settings.max_plan_ms
         && predicted_ms > limit_ms
     {
-        metrics::counter!("vigil_plans_refused_total", "reason" => "cost").increment(1);
+        metrics::counter!(metric_names::PLANS_REFUSED_TOTAL, "reason" => "cost").increment(1);
         return Err(ApiError::PlanTooCostly {
             predicted_ms,
             limit_ms,
@@ -97,10 +98,10 @@ pub(super) async fn plan_admitted(
     let guard = CancelOnDrop::new("plan", start, state);
     let token = guard.token();
     let res = if state.settings.plans_inline() && predicted_ms <= INLINE_PLAN_MS {
-        metrics::counter!("vigil_plans_total", "on" => "worker").increment(1);
+        metrics::counter!(metric_names::PLANS_TOTAL, "on" => "worker").increment(1);
         super::queue::on_this_worker(|| planner.plan_here(&input, &token)).await
     } else {
-        metrics::counter!("vigil_plans_total", "on" => "pool").increment(1);
+        metrics::counter!(metric_names::PLANS_TOTAL, "on" => "pool").increment(1);
         super::queue::on_rayon(move || planner.plan_cancellable(&input, &token)).await
     };
     guard.finish();

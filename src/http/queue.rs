@@ -6,6 +6,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, OnceLock};
 
 use super::error::ApiError;
+use crate::metric_names;
 
 /// Pieces of work that may wait for a rayon worker, per worker; past that,
 /// more are shed at once with 503. Eight plans of the reference workload
@@ -132,7 +133,7 @@ pub(crate) fn queue_full() -> bool {
 
 /// Counts a request shed for load.
 pub(crate) fn count_shed() {
-    metrics::counter!("vigil_http_shed_total").increment(1);
+    metrics::counter!(metric_names::HTTP_SHED_TOTAL).increment(1);
 }
 
 #[cfg(test)]

@@ -25,6 +25,7 @@ use std::sync::{Arc, Mutex, PoisonError};
 use std::task::{Context, Poll};
 use std::time::Duration;
 
+use crate::metric_names;
 use axum::Router;
 use axum::body::Body;
 use hyper::body::Incoming;
@@ -223,16 +224,16 @@ pub async fn serve(
         };
         let Ok(slot) = Arc::clone(&slots).try_acquire_owned() else {
             // Full: close this one at once; the open ones go on.
-            metrics::counter!("vigil_connections_refused_total").increment(1);
+            metrics::counter!(metric_names::CONNECTIONS_REFUSED_TOTAL).increment(1);
             drop(stream);
             continue;
         };
         let (app, mut stop_rx) = (app.clone(), stop_rx.clone());
         tokio::spawn(async move {
             let _slot = slot;
-            metrics::gauge!("vigil_connections_open").increment(1.0);
+            metrics::gauge!(metric_names::CONNECTIONS_OPEN).increment(1.0);
             serve_connection(stream, app, limits, &mut stop_rx).await;
-            metrics::gauge!("vigil_connections_open").decrement(1.0);
+            metrics::gauge!(metric_names::CONNECTIONS_OPEN).decrement(1.0);
         });
     }
     drop(listener);
@@ -288,7 +289,7 @@ async fn serve_connection(
                 if let (Some((_, why)), Some((at, _))) = (deadline, watch.deadline(&limits))
                     && at <= Instant::now()
                 {
-                    metrics::counter!("vigil_connections_closed_total", "reason" => why).increment(1);
+                    metrics::counter!(metric_names::CONNECTIONS_CLOSED_TOTAL, "reason" => why).increment(1);
                     return;
                 }
             }

@@ -8,6 +8,7 @@ use std::time::{Duration, Instant};
 use lru::LruCache;
 
 use super::error::ApiError;
+use crate::metric_names;
 use crate::session::Session;
 
 /// A session shared by its requests; its steps run one at a time.
@@ -51,9 +52,10 @@ impl SessionStore {
                 break;
             }
             map.pop_lru();
-            metrics::counter!("vigil_sessions_evicted_total", "reason" => "idle").increment(1);
+            metrics::counter!(metric_names::SESSIONS_EVICTED_TOTAL, "reason" => "idle")
+                .increment(1);
         }
-        metrics::gauge!("vigil_sessions_live").set(map.len() as f64);
+        metrics::gauge!(metric_names::SESSIONS_LIVE).set(map.len() as f64);
     }
 
     /// Keeps a new session under a fresh id, evicting the least recently
@@ -66,10 +68,11 @@ impl SessionStore {
         self.sweep(&mut map, now);
         while map.len() >= self.capacity {
             map.pop_lru();
-            metrics::counter!("vigil_sessions_evicted_total", "reason" => "capacity").increment(1);
+            metrics::counter!(metric_names::SESSIONS_EVICTED_TOTAL, "reason" => "capacity")
+                .increment(1);
         }
         map.put(id.clone(), (shared.clone(), now));
-        metrics::gauge!("vigil_sessions_live").set(map.len() as f64);
+        metrics::gauge!(metric_names::SESSIONS_LIVE).set(map.len() as f64);
         (id, shared)
     }
 
@@ -98,7 +101,7 @@ impl SessionStore {
         let mut map = self.lock();
         self.sweep(&mut map, Instant::now());
         let removed = map.pop(id).map(|_| ()).ok_or_else(|| self.not_found(id));
-        metrics::gauge!("vigil_sessions_live").set(map.len() as f64);
+        metrics::gauge!(metric_names::SESSIONS_LIVE).set(map.len() as f64);
         removed
     }
 

@@ -35,6 +35,7 @@ use sqlx::postgres::{PgConnectOptions, PgListener, PgPool, PgPoolOptions};
 use sqlx::{Connection, PgConnection};
 
 use super::FORMAT;
+use crate::metric_names;
 use crate::scenario::{Scenario, ScenarioSpec};
 
 /// The schema's migrations, from `migrations/`.
@@ -125,7 +126,7 @@ impl PgStore {
             timeout,
             up: Arc::new(AtomicBool::new(true)),
         };
-        metrics::gauge!("vigil_database_up").set(1.0);
+        metrics::gauge!(metric_names::DATABASE_UP).set(1.0);
         Ok(store)
     }
 
@@ -142,7 +143,7 @@ impl PgStore {
                 tracing::warn!("the database is unreachable");
             }
         }
-        metrics::gauge!("vigil_database_up").set(if up { 1.0 } else { 0.0 });
+        metrics::gauge!(metric_names::DATABASE_UP).set(if up { 1.0 } else { 0.0 });
     }
 
     /// Runs `call` within the timeout (a short one while the database is
