@@ -124,18 +124,119 @@ pub const PLAN_MODEL: [(&str, f64); 18] = [
     ("paper iterated: cells × n × (1 + ov)", 7.370e-6),
 ];
 
+/// The units of work of one precomputation, one per term of [`PRECOMPUTE_MODEL`] (same order).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PrecomputeTerms {
+    /// pairs: square, half-plane sources (`PRECOMPUTE_MODEL[0]`).
+    pub square_half_plane: f64,
+    /// pairs: square, cone sources (`PRECOMPUTE_MODEL[1]`).
+    pub square_cones: f64,
+    /// pairs: circle, in cones (`PRECOMPUTE_MODEL[2]`).
+    pub circle_in_cones: f64,
+    /// pairs: circle, outside cones (`PRECOMPUTE_MODEL[3]`).
+    pub circle_outside_cones: f64,
+    /// grid: rects × half-plane sources (`PRECOMPUTE_MODEL[4]`).
+    pub grid_half_plane: f64,
+    /// grid: rects × cone sources (`PRECOMPUTE_MODEL[5]`).
+    pub grid_cones: f64,
+    /// crossings: rays × (nx + ny) (`PRECOMPUTE_MODEL[6]`).
+    pub crossings: f64,
+}
+
+impl PrecomputeTerms {
+    /// The terms in the order of [`PRECOMPUTE_MODEL`].
+    pub fn to_array(&self) -> [f64; 7] {
+        [
+            self.square_half_plane,
+            self.square_cones,
+            self.circle_in_cones,
+            self.circle_outside_cones,
+            self.grid_half_plane,
+            self.grid_cones,
+            self.crossings,
+        ]
+    }
+}
+
+/// The units of work of one plan, one per term of [`PLAN_MODEL`] (same order).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PlanTerms {
+    /// 1 (`PLAN_MODEL[0]`).
+    pub constant: f64,
+    /// seen: look-rays, certain (`PLAN_MODEL[1]`).
+    pub seen_certain: f64,
+    /// seen: look-rays, uncertain (`PLAN_MODEL[2]`).
+    pub seen_uncertain: f64,
+    /// seen: sorting pieces (`PLAN_MODEL[3]`).
+    pub seen_sorting: f64,
+    /// windows: T × look-rays (whole grid) (`PLAN_MODEL[4]`).
+    pub windows_look_rays: f64,
+    /// windows: T × rects (whole grid) (`PLAN_MODEL[5]`).
+    pub windows_rects: f64,
+    /// windows: blocks (`PLAN_MODEL[6]`).
+    pub windows_blocks: f64,
+    /// fill: cells (`PLAN_MODEL[7]`).
+    pub fill_cells: f64,
+    /// fill: rects × (1 + E in rows) (`PLAN_MODEL[8]`).
+    pub fill_rects: f64,
+    /// fill: targets × looks checked (`PLAN_MODEL[9]`).
+    pub fill_targets: f64,
+    /// fill: cells × clear targets (`PLAN_MODEL[10]`).
+    pub fill_clear_targets: f64,
+    /// general: cells × classes (`PLAN_MODEL[11]`).
+    pub general_classes: f64,
+    /// general: cells × rays × (1 + ov) (`PLAN_MODEL[12]`).
+    pub general_rays: f64,
+    /// general: cells × targets (`PLAN_MODEL[13]`).
+    pub general_targets: f64,
+    /// paper: setup (`PLAN_MODEL[14]`).
+    pub paper_setup: f64,
+    /// paper: cells × (seen + E) (`PLAN_MODEL[15]`).
+    pub paper_cells: f64,
+    /// paper: cells × ov² (`PLAN_MODEL[16]`).
+    pub paper_overlaps: f64,
+    /// paper iterated: cells × n × (1 + ov) (`PLAN_MODEL[17]`).
+    pub paper_iterated: f64,
+}
+
+impl PlanTerms {
+    /// The terms in the order of [`PLAN_MODEL`].
+    pub fn to_array(&self) -> [f64; 18] {
+        [
+            self.constant,
+            self.seen_certain,
+            self.seen_uncertain,
+            self.seen_sorting,
+            self.windows_look_rays,
+            self.windows_rects,
+            self.windows_blocks,
+            self.fill_cells,
+            self.fill_rects,
+            self.fill_targets,
+            self.fill_clear_targets,
+            self.general_classes,
+            self.general_rays,
+            self.general_targets,
+            self.paper_setup,
+            self.paper_cells,
+            self.paper_overlaps,
+            self.paper_iterated,
+        ]
+    }
+}
+
 /// Predicted CPU time of [`Planner::new`] on `s`, milliseconds on one
 /// core: positive and finite for every valid scenario; O(sources + fields
 /// of view) to compute.
 pub fn precompute_ms(s: &Scenario) -> f64 {
-    dot(&PRECOMPUTE_MODEL, &precompute_terms(s)).max(FLOOR_MS)
+    dot(&PRECOMPUTE_MODEL, &precompute_terms(s).to_array()).max(FLOOR_MS)
 }
 
 /// Predicted CPU time of planning `input` on `planner`
 /// ([`Planner::plan`]), milliseconds on one core: positive and finite;
 /// O(sensors² + targets + history) to compute (microseconds).
 pub fn plan_ms(planner: &Planner, input: &PlanInput) -> f64 {
-    let work = dot(&PLAN_MODEL, &plan_terms(planner, input)).max(FLOOR_MS);
+    let work = dot(&PLAN_MODEL, &plan_terms(planner, input).to_array()).max(FLOOR_MS);
     // `joint` may use all of its budget on top of `iterated`'s work.
     match (input.coordination, input.estimator) {
         (Coordination::Joint, EstimatorKind::Exact) => {
@@ -154,7 +255,7 @@ fn dot<const N: usize>(model: &[(&str, f64); N], terms: &[f64; N]) -> f64 {
 }
 
 /// The terms of [`PRECOMPUTE_MODEL`] for `s` (for fitting and checks).
-pub fn precompute_terms(s: &Scenario) -> [f64; 7] {
+pub fn precompute_terms(s: &Scenario) -> PrecomputeTerms {
     let cells = s.cell_count() as f64;
     let mut buf = Vec::new();
     let (mut cover, mut cone, mut inside) = (0.0, 0.0, 0.0);
@@ -166,18 +267,18 @@ pub fn precompute_terms(s: &Scenario) -> [f64; 7] {
             cone += 1.0;
         }
     }
-    let mut t = [0.0; 7];
+    let mut t = PrecomputeTerms::default();
     let mut halves = Vec::new();
     for &fov in &s.fovs {
         match fov {
             FovSpec::Square { half_width } => {
-                t[0] += cells * cover;
-                t[1] += cells * cone;
+                t.square_half_plane += cells * cover;
+                t.square_cones += cells * cone;
                 halves.push(half_width);
             }
             FovSpec::Circle { .. } => {
-                t[2] += cells * inside;
-                t[3] += cells * (cover + cone - inside);
+                t.circle_in_cones += cells * inside;
+                t.circle_outside_cones += cells * (cover + cone - inside);
             }
         }
     }
@@ -189,13 +290,13 @@ pub fn precompute_terms(s: &Scenario) -> [f64; 7] {
         // ~100 bytes a cell.
         let one = (2.0 * s.cols as f64 + 1.0) * (2.0 * s.rows as f64 + 1.0);
         if nx * ny <= one.max(MAX_SMALL_GRID as f64) {
-            t[4] = nx * ny * cover;
-            t[5] = nx * ny * cone;
+            t.grid_half_plane = nx * ny * cover;
+            t.grid_cones = nx * ny * cone;
             let rays: f64 = source_rays(s).iter().map(|r| r.1).sum();
             if rays * (nx + ny)
                 <= (INDEX_CROSSINGS_PER_CELL as f64 * cells).max(MIN_INDEX_CROSSINGS as f64)
             {
-                t[6] = rays * (nx + ny);
+                t.crossings = rays * (nx + ny);
             }
         }
     }
@@ -264,7 +365,7 @@ fn half(fov: FovSpec) -> f64 {
 
 /// The terms of [`PLAN_MODEL`] for `input` on `planner` (for fitting and
 /// checks).
-pub fn plan_terms(planner: &Planner, input: &PlanInput) -> [f64; 18] {
+pub fn plan_terms(planner: &Planner, input: &PlanInput) -> PlanTerms {
     let s = &planner.scenario;
     let (n, big_t, cs) = (input.starts.len(), input.horizon, s.cell_size);
     let exact = input.estimator == EstimatorKind::Exact;
@@ -338,18 +439,24 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> [f64; 18] {
     }
     let known = in_zone[0];
 
-    let mut t = [0.0; 18];
-    t[0] = 1.0;
+    let mut t = PlanTerms {
+        constant: 1.0,
+        ..PlanTerms::default()
+    };
     if exact {
         let certain = s.types.iter().all(|ty| ty.p_detect == 1.0);
-        t[if certain { 1 } else { 2 }] = look_rays;
+        if certain {
+            t.seen_certain = look_rays;
+        } else {
+            t.seen_uncertain = look_rays;
+        }
         let pieces = n as f64 * per_look;
-        t[3] = pieces * (2.0 + pieces / all_rays.max(1.0)).log2();
+        t.seen_sorting = pieces * (2.0 + pieces / all_rays.max(1.0)).log2();
     }
     let whole = grid.is_some_and(|g| g.dims().0 * g.dims().1 <= ONE_WINDOW_RECTANGLES);
     if let (Some(g), true) = (grid, whole) {
-        t[4] = big_t as f64 * look_rays;
-        t[5] = (big_t * g.dims().0 * g.dims().1) as f64;
+        t.windows_look_rays = big_t as f64 * look_rays;
+        t.windows_rects = (big_t * g.dims().0 * g.dims().1) as f64;
     }
     let rounds = if exact {
         1.0 + (mean_near / 10.0).min(4.0)
@@ -425,30 +532,31 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> [f64; 18] {
             blocks[step] += rects / own;
             for (&(w, share), &miss) in passes.iter().zip(&miss) {
                 let ex = e * share;
-                t[7] += w * cells;
+                t.fill_cells += w * cells;
                 if grid.is_some() {
-                    t[8] += w * rects * (1.0 + ex * (own_rows / rows).min(1.0));
+                    t.fill_rects += w * rects * (1.0 + ex * (own_rows / rows).min(1.0));
                     // A target's check stops at the first look that
                     // holds it: about 1/a looks when they cover a lot.
                     let checks = if a > 0.0 { (1.0 - miss) / a } else { ex };
-                    t[9] += w * (known + in_zone[step] * checks);
-                    t[10] += w * cells * in_zone[step] * miss;
+                    t.fill_targets += w * (known + in_zone[step] * checks);
+                    t.fill_clear_targets += w * cells * in_zone[step] * miss;
                 } else if exact {
-                    t[11] += w * cells * classes;
-                    t[12] += w * cells * per_look * (1.0 + ov * share);
-                    t[13] += w * cells * known;
+                    t.general_classes += w * cells * classes;
+                    t.general_rays += w * cells * per_look * (1.0 + ov * share);
+                    t.general_targets += w * cells * known;
                 } else {
-                    t[15] += w * cells * (known * a + ex);
-                    t[16] += w * cells * (ov * share).powi(2);
+                    t.paper_cells += w * cells * (known * a + ex);
+                    t.paper_overlaps += w * cells * (ov * share).powi(2);
                     if share == 1.0 {
-                        t[17] += w * cells * n as f64 * (1.0 + ov);
+                        t.paper_iterated += w * cells * n as f64 * (1.0 + ov);
                     }
                 }
             }
         }
         if !exact {
             let reach = (2 * ty.speed * big_t + 1) as f64;
-            t[14] += reach * reach + known + ESCAPE_SAMPLES as f64 * (rays.len() as f64 + classes);
+            t.paper_setup +=
+                reach * reach + known + ESCAPE_SAMPLES as f64 * (rays.len() as f64 + classes);
         }
     }
     if grid.is_some() && !whole {
@@ -458,7 +566,7 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> [f64; 18] {
         for step in 1..=big_t {
             let b = bbox[step];
             let size = ((b.1 - b.0) * (b.3 - b.2)) as f64;
-            t[6] += per_look
+            t.windows_blocks += per_look
                 * if size <= (ONE_WINDOW_RECTANGLES as f64).max(2.0 * total[step]) {
                     size * n as f64 / fov_rects
                 } else {
@@ -555,7 +663,7 @@ mod tests {
                     let mut req = request(&p.scenario, n, 3, targets, history);
                     req.estimator = Some(estimator);
                     let input = PlanInput::new(&p.scenario, &req).expect("valid");
-                    let terms = plan_terms(&p, &input);
+                    let terms = plan_terms(&p, &input).to_array();
                     assert!(terms.iter().all(|t| t.is_finite() && *t >= 0.0));
                     let ms = plan_cost(&p, req, c);
                     assert!(ms.is_finite() && ms > 0.0, "{}: {ms}", p.scenario.id);

@@ -790,9 +790,11 @@ fn main() {
                 if case.name == "reference#0" {
                     reference_us = us;
                 }
-                cost::plan_terms(planner, &input).to_vec()
+                cost::plan_terms(planner, &input).to_array().to_vec()
             }
-            Work::Precompute(s) | Work::PredictOnly(s) => cost::precompute_terms(s).to_vec(),
+            Work::Precompute(s) | Work::PredictOnly(s) => {
+                cost::precompute_terms(s).to_array().to_vec()
+            }
         };
         results.push((ci, terms, f64::NAN));
     }
