@@ -761,11 +761,16 @@ fn programme<S: Score>(grid: &ValueGrid) -> BestPath {
         }
         let next = &later[..n];
         if mo.open {
-            let (lo, hi) = (e - k, e + k);
+            let scores = StepScores { vals, viols };
+            let reach = Reach {
+                side,
+                lo: e - k,
+                hi: e + k,
+            };
             match speed {
-                1 => open_layer::<1, S>(vals, viols, side, lo, hi, next, &mut rowmax, cur),
-                2 => open_layer::<2, S>(vals, viols, side, lo, hi, next, &mut rowmax, cur),
-                _ => open_layer::<3, S>(vals, viols, side, lo, hi, next, &mut rowmax, cur),
+                1 => open_layer::<1, S>(scores, reach, next, &mut rowmax, cur),
+                2 => open_layer::<2, S>(scores, reach, next, &mut rowmax, cur),
+                _ => open_layer::<3, S>(scores, reach, next, &mut rowmax, cur),
             }
         } else {
             for r in rows {
@@ -825,6 +830,24 @@ fn programme<S: Score>(grid: &ValueGrid) -> BestPath {
     }
 }
 
+/// One step's scores in [`best_path`]'s programme: the values (`None`
+/// where the offset cannot be stood on) and the violation counts (empty
+/// when none are counted), indexed by offset.
+#[derive(Clone, Copy)]
+struct StepScores<'a> {
+    vals: &'a [Option<f64>],
+    viols: &'a [u16],
+}
+
+/// The offsets a sensor can reach at one step: the box `lo..=hi` ×
+/// `lo..=hi` of a square of offsets `side` wide.
+#[derive(Clone, Copy)]
+struct Reach {
+    side: usize,
+    lo: usize,
+    hi: usize,
+}
+
 /// One layer of [`best_path`]'s programme for an open motion of speed `M`
 /// (every offset free): `cur[o] = score(o) + max of next over the (2M+1)²
 /// square around o` for `o` in the box `lo..=hi` × `lo..=hi` of step t
@@ -833,18 +856,16 @@ fn programme<S: Score>(grid: &ValueGrid) -> BestPath {
 /// along columns. `hi + M` is inside the square of offsets (t < T), and the
 /// maximum is associative and commutative (up to the sign of zeros), so
 /// `best` compares exactly as the successor lists' fold would.
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn open_layer<const M: usize, S: Score>(
-    vals: &[Option<f64>],
-    viols: &[u16],
-    side: usize,
-    lo: usize,
-    hi: usize,
+    scores: StepScores<'_>,
+    reach: Reach,
     next: &[S],
     rowmax: &mut [S],
     cur: &mut [S],
 ) {
+    let StepScores { vals, viols } = scores;
+    let Reach { side, lo, hi } = reach;
     for r in lo - M..=hi + M {
         let row = r * side;
         let src = &next[row + lo - M..=row + hi + M];

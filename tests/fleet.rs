@@ -9,7 +9,9 @@ use std::collections::{BTreeMap, HashSet};
 
 use rand::{RngExt, SeedableRng, rngs::StdRng};
 use rayon::prelude::*;
-use vigil::estimator::{ElementaryGrid, Estimator, ExactEstimator, SourceRays, Target};
+use vigil::estimator::{
+    ElementaryGrid, Estimator, ExactEstimator, Precomputed, Situation, SourceRays, Target,
+};
 use vigil::planner::{Id, PlanRequest, Planner, PositionIn, SensorIn, TargetIn};
 use vigil::scenario::{
     Cell, FovSpec, Look, NoGoSpec, Scenario, ScenarioSpec, SensorTypeSpec, paper_spec,
@@ -133,15 +135,19 @@ fn run(
                 .collect();
             let observed: Vec<Vec<Look>> = (0..=history).map(looks_at).collect();
             let est = ExactEstimator::new(
-                s,
-                &stats,
-                &rays,
-                grid.as_ref(),
-                &observed,
-                &reported,
-                &starts,
-                types,
-                tmax,
+                Precomputed {
+                    scenario: s,
+                    stats: &stats,
+                    rays: &rays,
+                    grid: grid.as_ref(),
+                },
+                Situation {
+                    observed: &observed,
+                    targets: &reported,
+                    starts: &starts,
+                    types,
+                    horizon: tmax,
+                },
             );
             let predicted: Vec<f64> = probes
                 .iter()
@@ -344,15 +350,19 @@ fn treating_uncertain_looks_as_certain_is_detected_as_biased() {
                 })
                 .collect();
             let est = ExactEstimator::new(
-                &wrong,
-                &stats,
-                &rays,
-                Some(&grid),
-                &observed,
-                &reported,
-                &track(0),
-                &types,
-                1,
+                Precomputed {
+                    scenario: &wrong,
+                    stats: &stats,
+                    rays: &rays,
+                    grid: Some(&grid),
+                },
+                Situation {
+                    observed: &observed,
+                    targets: &reported,
+                    starts: &track(0),
+                    types: &types,
+                    horizon: 1,
+                },
             );
             let predicted: Vec<f64> = probes
                 .iter()
@@ -437,15 +447,19 @@ fn fast_and_general_paths_agree_with_mixed_types() {
         let horizon = 2;
         let new_estimator = || {
             ExactEstimator::new(
-                &s,
-                &stats,
-                &rays,
-                Some(&grid),
-                &history,
-                &targets,
-                &starts,
-                &types,
-                horizon,
+                Precomputed {
+                    scenario: &s,
+                    stats: &stats,
+                    rays: &rays,
+                    grid: Some(&grid),
+                },
+                Situation {
+                    observed: &history,
+                    targets: &targets,
+                    starts: &starts,
+                    types: &types,
+                    horizon,
+                },
             )
         };
         // One with every window built up front (all steps in one pass when

@@ -10,7 +10,8 @@ use rand::{SeedableRng, rngs::StdRng};
 use rayon::prelude::*;
 use vigil::coordination::Coordination;
 use vigil::estimator::{
-    ElementaryGrid, Estimator, ExactEstimator, RAYS_PER_PI_SQUARE, SourceRays, Target,
+    ElementaryGrid, Estimator, ExactEstimator, Precomputed, RAYS_PER_PI_SQUARE, Situation,
+    SourceRays, Target,
 };
 use vigil::geometry::{Point, Region};
 use vigil::planner::{EstimatorKind, Id, PlanRequest, Planner, SensorIn, TargetIn};
@@ -233,15 +234,19 @@ fn run_unbiasedness_with(
                 })
                 .collect();
             let est = ExactEstimator::new(
-                model,
-                std::slice::from_ref(&stats),
-                &rays,
-                grid.as_ref(),
-                &observed,
-                &reported,
-                &sensors,
-                &vec![0; sensors.len()],
-                tmax,
+                Precomputed {
+                    scenario: model,
+                    stats: std::slice::from_ref(&stats),
+                    rays: &rays,
+                    grid: grid.as_ref(),
+                },
+                Situation {
+                    observed: &observed,
+                    targets: &reported,
+                    starts: &sensors,
+                    types: &vec![0; sensors.len()],
+                    horizon: tmax,
+                },
             );
             let predicted: Vec<f64> = probes
                 .iter()
@@ -568,15 +573,19 @@ fn fast_and_general_exact_paths_agree() {
                 .collect();
             let horizon = 3;
             let est = ExactEstimator::new(
-                s,
-                std::slice::from_ref(&stats),
-                rays,
-                grid.as_ref(),
-                &history,
-                &targets,
-                &starts,
-                &[0; 4],
-                horizon,
+                Precomputed {
+                    scenario: s,
+                    stats: std::slice::from_ref(&stats),
+                    rays,
+                    grid: grid.as_ref(),
+                },
+                Situation {
+                    observed: &history,
+                    targets: &targets,
+                    starts: &starts,
+                    types: &[0; 4],
+                    horizon,
+                },
             );
             for (i, &start) in starts.iter().enumerate() {
                 let other = starts[(i + 1) % starts.len()];

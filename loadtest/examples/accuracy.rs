@@ -1,6 +1,8 @@
 #![allow(missing_docs, clippy::unwrap_used)]
 //! Error of the exact estimator's values against a fine angular grid.
-use vigil::estimator::{ElementaryGrid, Estimator, ExactEstimator, SourceRays, Target};
+use vigil::estimator::{
+    ElementaryGrid, Estimator, ExactEstimator, Precomputed, Situation, SourceRays, Target,
+};
 use vigil::geometry::Point;
 use vigil::planner::Planner;
 use vigil::scenario::{Cell, Look, builtins};
@@ -42,26 +44,34 @@ fn main() {
                 })
                 .collect();
             let a = ExactEstimator::new(
-                &s,
-                std::slice::from_ref(&stats),
-                &rays,
-                grid.as_ref(),
-                &observed,
-                &targets,
-                &starts,
-                &vec![0; starts.len()],
-                3,
+                Precomputed {
+                    scenario: &s,
+                    stats: std::slice::from_ref(&stats),
+                    rays: &rays,
+                    grid: grid.as_ref(),
+                },
+                Situation {
+                    observed: &observed,
+                    targets: &targets,
+                    starts: &starts,
+                    types: &vec![0; starts.len()],
+                    horizon: 3,
+                },
             );
             let b = ExactEstimator::new(
-                &s,
-                std::slice::from_ref(&stats),
-                &fine,
-                grid.as_ref(),
-                &observed,
-                &targets,
-                &starts,
-                &vec![0; starts.len()],
-                3,
+                Precomputed {
+                    scenario: &s,
+                    stats: std::slice::from_ref(&stats),
+                    rays: &fine,
+                    grid: grid.as_ref(),
+                },
+                Situation {
+                    observed: &observed,
+                    targets: &targets,
+                    starts: &starts,
+                    types: &vec![0; starts.len()],
+                    horizon: 3,
+                },
             );
             for (i, &c) in starts.iter().enumerate() {
                 for t in 1..=3 {

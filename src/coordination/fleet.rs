@@ -49,7 +49,6 @@ pub struct Fleet<'a> {
 
 impl<'a> Fleet<'a> {
     /// The fleet of `starts.len()` sensors; builds each one's motion.
-    #[allow(clippy::too_many_arguments)]
     pub fn new(
         scenario: &'a Scenario,
         est: &'a dyn Estimator,

@@ -312,21 +312,35 @@ impl ElementaryGrid {
 /// A half-open block `[a0, a1) × [b0, b1)` of elementary rectangles.
 pub(crate) type Block = (usize, usize, usize, usize);
 
+/// The part `[from, to]` (distances from `origin`) of the ray from
+/// `origin` along the unit direction `dir`; `inv` is `dir`'s componentwise
+/// inverse, computed once per ray.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Segment {
+    pub origin: Point,
+    pub dir: Point,
+    pub inv: Point,
+    pub from: f64,
+    pub to: f64,
+}
+
 /// Calls `f(a, b, from, to)` for each elementary rectangle `(a, b)` of
-/// `block` the ray segment `[r0, r1]` crosses, in order, with the part of
-/// the segment inside it: a 2-D DDA over the breakpoints. The segment lies
-/// inside the block; rounding at its edge is clamped.
-#[allow(clippy::too_many_arguments)]
+/// `block` the ray segment crosses, in order, with the part of the segment
+/// inside it: a 2-D DDA over the breakpoints. The segment lies inside the
+/// block; rounding at its edge is clamped.
 pub(crate) fn trace(
     grid: &ElementaryGrid,
     block: Block,
-    o: Point,
-    d: Point,
-    inv: Point,
-    r0: f64,
-    r1: f64,
+    segment: Segment,
     mut f: impl FnMut(usize, usize, f64, f64),
 ) {
+    let Segment {
+        origin: o,
+        dir: d,
+        inv,
+        from: r0,
+        to: r1,
+    } = segment;
     let (xs, ys) = (&grid.xs, &grid.ys);
     let (a_lo, a_hi, b_lo, b_hi) = (block.0, block.1 - 1, block.2, block.3 - 1);
     let start = Point::new(o.x + d.x * r0, o.y + d.y * r0);

@@ -17,7 +17,7 @@ mod paper;
 pub use elementary::{ElementaryGrid, MAX_SMALL_GRID};
 pub use exact::{
     ExactEstimator, INDEX_CROSSINGS_PER_CELL, MIN_INDEX_CROSSINGS, ONE_WINDOW_RECTANGLES,
-    RAYS_PER_PI, RAYS_PER_PI_SQUARE, SourceRays,
+    Precomputed, RAYS_PER_PI, RAYS_PER_PI_SQUARE, Situation, SourceRays,
 };
 pub use paper::PaperEstimator;
 

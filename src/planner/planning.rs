@@ -9,7 +9,9 @@ use super::input::PlanInput;
 use super::wire::*;
 use crate::cancel::{CancelToken, Cancelled, Progress};
 use crate::coordination::{Fleet, coordinate};
-use crate::estimator::{ElementaryGrid, Estimator, ExactEstimator, PaperEstimator, SourceRays};
+use crate::estimator::{
+    ElementaryGrid, Estimator, ExactEstimator, PaperEstimator, Precomputed, Situation, SourceRays,
+};
 use crate::scenario::{Cell, Look, Scenario, ValidationError};
 use crate::stats::Stats;
 
@@ -234,15 +236,19 @@ impl Planner {
             EstimatorKind::Exact => {
                 let observed = self.observed_looks(input);
                 let est = ExactEstimator::new(
-                    s,
-                    &self.stats,
-                    &self.rays,
-                    self.grid.as_ref(),
-                    &observed,
-                    &input.targets,
-                    &input.starts,
-                    &input.types,
-                    input.horizon,
+                    Precomputed {
+                        scenario: s,
+                        stats: &self.stats,
+                        rays: &self.rays,
+                        grid: self.grid.as_ref(),
+                    },
+                    Situation {
+                        observed: &observed,
+                        targets: &input.targets,
+                        starts: &input.starts,
+                        types: &input.types,
+                        horizon: input.horizon,
+                    },
                 );
                 cancel.check()?;
                 est.prepare();

@@ -93,6 +93,35 @@ pub struct ExactEstimator<'a> {
     windows: Vec<StepWindows>,
 }
 
+/// What a scenario precomputed once, which every exact estimator of it
+/// reads.
+#[derive(Debug, Clone, Copy)]
+pub struct Precomputed<'a> {
+    /// The scenario.
+    pub scenario: &'a Scenario,
+    /// Its statistics per field of view (its `fovs`).
+    pub stats: &'a [Stats],
+    /// Its sources' rays.
+    pub rays: &'a [SourceRays],
+    /// Its elementary grid (square fields of view only).
+    pub grid: Option<&'a ElementaryGrid>,
+}
+
+/// What the sensors know and where they are, for one plan.
+#[derive(Debug, Clone, Copy)]
+pub struct Situation<'a> {
+    /// `observed[s]`: the looks taken `s` steps ago (index 0: now).
+    pub observed: &'a [Vec<Look>],
+    /// The targets detected (tracked) now.
+    pub targets: &'a [Target],
+    /// The sensors' cells now.
+    pub starts: &'a [Cell],
+    /// The sensors' types (indices into the scenario's).
+    pub types: &'a [usize],
+    /// The longest path planned, steps.
+    pub horizon: usize,
+}
+
 impl<'a> ExactEstimator<'a> {
     /// What the sensors saw along the classes' rays, which windows are
     /// filled from.
@@ -104,25 +133,24 @@ impl<'a> ExactEstimator<'a> {
         }
     }
 
-    /// Prepares the estimator for sensors of types `types` starting at
-    /// `starts` and paths of up to `horizon` steps. `stats` are the
-    /// scenario's statistics per field of view (its `fovs`), `observed[s]`
-    /// the looks taken `s` steps ago (index 0: now). Targets outside the
-    /// zone are ignored: they have left it, or have not entered and cannot
-    /// have been seen. With `grid` (square fields of view) values near the
-    /// sensors use the fast path.
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        scenario: &'a Scenario,
-        stats: &'a [Stats],
-        rays: &'a [SourceRays],
-        grid: Option<&'a ElementaryGrid>,
-        observed: &[Vec<Look>],
-        targets: &[Target],
-        starts: &[Cell],
-        types: &[usize],
-        horizon: usize,
-    ) -> Self {
+    /// Prepares the estimator of a scenario's `precomputed` pieces for the
+    /// sensors of `now`. Targets outside the zone are ignored: they have
+    /// left it, or have not entered and cannot have been seen. With a grid
+    /// (square fields of view) values near the sensors use the fast path.
+    pub fn new(precomputed: Precomputed<'a>, now: Situation<'_>) -> Self {
+        let Precomputed {
+            scenario,
+            stats,
+            rays,
+            grid,
+        } = precomputed;
+        let Situation {
+            observed,
+            targets,
+            starts,
+            types,
+            horizon,
+        } = now;
         let classes: Vec<ClassRays> = rays
             .iter()
             .enumerate()

@@ -4,7 +4,7 @@
 
 use rayon::prelude::*;
 
-use crate::estimator::elementary::{ElementaryGrid, trace};
+use crate::estimator::elementary::{ElementaryGrid, Segment, trace};
 use crate::geometry::{Point, Rect, Region};
 use crate::scenario::{Cell, FovSpec, Scenario, Source};
 use crate::stats::angular_span;
@@ -288,20 +288,18 @@ impl SourceRays {
             offsets.push(0);
             for &(d, inv) in &sr.dirs {
                 if let Some((r0, r1)) = zone.ray(sr.source.pos, d, inv) {
-                    trace(
-                        grid,
-                        (0, nx, 0, ny),
-                        sr.source.pos,
-                        d,
+                    let segment = Segment {
+                        origin: sr.source.pos,
+                        dir: d,
                         inv,
-                        r0,
-                        r1,
-                        |a, b, from, _| {
-                            r.push(from);
-                            cells.push([a as u32, b as u32]);
-                            lin.push((b * nx + a) as u32);
-                        },
-                    );
+                        from: r0,
+                        to: r1,
+                    };
+                    trace(grid, (0, nx, 0, ny), segment, |a, b, from, _| {
+                        r.push(from);
+                        cells.push([a as u32, b as u32]);
+                        lin.push((b * nx + a) as u32);
+                    });
                     r.push(r1);
                 } else {
                     r.push(0.0);

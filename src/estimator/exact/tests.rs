@@ -1,8 +1,8 @@
 //! The seen sets along rays, checked against the estimator's values.
 
-use super::ExactEstimator;
 use super::rays::{SourceRays, look_key};
 use super::seen::RayHits;
+use super::{ExactEstimator, Precomputed, Situation};
 use crate::estimator::Estimator;
 use crate::estimator::elementary::ElementaryGrid;
 use crate::scenario::{Cell, FovSpec, Look, Scenario, builtins, site_fleet_spec};
@@ -51,15 +51,19 @@ fn intervals_past_the_exit_change_no_value() {
         let horizon = 3;
         let build = |rays| {
             let est = ExactEstimator::new(
-                &s,
-                &stats,
-                rays,
-                Some(&grid),
-                &observed,
-                &[],
-                &starts,
-                &types,
-                horizon,
+                Precomputed {
+                    scenario: &s,
+                    stats: &stats,
+                    rays,
+                    grid: Some(&grid),
+                },
+                Situation {
+                    observed: &observed,
+                    targets: &[],
+                    starts: &starts,
+                    types: &types,
+                    horizon,
+                },
             );
             est.prepare();
             est

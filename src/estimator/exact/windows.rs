@@ -8,8 +8,8 @@ use rayon::prelude::*;
 
 use super::rays::{ClassRays, Crossings, SourceRays, max, min};
 use super::seen::RayHits;
-use crate::estimator::elementary::{Block, ElementaryGrid, trace};
-use crate::geometry::{Point, Region};
+use crate::estimator::elementary::{Block, ElementaryGrid, Segment, trace};
+use crate::geometry::Region;
 use crate::scenario::{Cell, Look, Scenario};
 
 /// Classes whose seen mass is added into one buffer of a window; the
@@ -176,6 +176,16 @@ impl Window {
     }
 }
 
+/// One target class at one step: its source's rays, along which what was
+/// seen at step 0 has moved on by `lift` (`v·t`), each ray carrying
+/// `weight` targets per unit of length.
+#[derive(Clone, Copy)]
+struct LiftedClass<'a> {
+    rays: &'a SourceRays,
+    lift: f64,
+    weight: f64,
+}
+
 /// What the sensors saw, along each target class's rays: the part of the
 /// exact estimator a window is filled from.
 pub(super) struct SeenRays<'a> {
@@ -221,9 +231,12 @@ impl SeenRays<'_> {
             .map(|(classes, seen)| {
                 let mut acc = vec![0.0; na * nb];
                 for (class, seen) in classes.iter().zip(seen) {
-                    let sr = &self.rays[class.rays];
-                    let lift = class.speed * t as f64;
-                    self.accumulate(grid, block, whole, lift, sr, class.weight, seen, &mut acc);
+                    let lifted = LiftedClass {
+                        rays: &self.rays[class.rays],
+                        lift: class.speed * t as f64,
+                        weight: class.weight,
+                    };
+                    Self::accumulate(grid, block, whole, lifted, seen, &mut acc);
                 }
                 acc
             })
@@ -317,20 +330,22 @@ impl SeenRays<'_> {
         Some(windows)
     }
 
-    /// Adds to `acc` what the rays of one source saw in each rectangle of
-    /// `block` at lift `v·t`, times the class's weight `w`.
-    #[allow(clippy::too_many_arguments)]
+    /// Adds to `acc` what the rays of one class saw in each rectangle of
+    /// `block` (the whole grid when `whole`), lifted and weighted as
+    /// `class` says.
     fn accumulate(
-        &self,
         grid: &ElementaryGrid,
         block: Block,
         whole: bool,
-        lift: f64,
-        sr: &SourceRays,
-        w: f64,
+        class: LiftedClass<'_>,
         seen: &RayHits,
         acc: &mut [f64],
     ) {
+        let LiftedClass {
+            rays: sr,
+            lift,
+            weight: w,
+        } = class;
         if let (true, Some(cr)) = (whole, &sr.crossings) {
             // The block is the grid: every ray, no bounds to check.
             accumulate_whole(cr, sr.dirs.len(), w, seen, &[lift], &mut [acc]);
@@ -379,7 +394,14 @@ impl SeenRays<'_> {
                     let w = weight(i);
                     let (p, q) = (max(p, wa) + lift, min(q, wb) + lift);
                     if q > p {
-                        walk(grid, block, acc, sr.source.pos, d, inv, p, q, w);
+                        let segment = Segment {
+                            origin: sr.source.pos,
+                            dir: d,
+                            inv,
+                            from: p,
+                            to: q,
+                        };
+                        walk(grid, block, acc, segment, w);
                     }
                 }
                 continue;
@@ -498,21 +520,10 @@ fn next_crossing(rs: &[f64], k: usize, p: f64) -> usize {
 }
 
 /// Adds to `acc`, the seen mass in each elementary rectangle of `block`,
-/// the ray segment `[r0, r1]` times `w`, rectangle by rectangle.
-#[allow(clippy::too_many_arguments)]
-fn walk(
-    grid: &ElementaryGrid,
-    block: Block,
-    acc: &mut [f64],
-    o: Point,
-    d: Point,
-    inv: Point,
-    r0: f64,
-    r1: f64,
-    w: f64,
-) {
+/// the ray segment times `w`, rectangle by rectangle.
+fn walk(grid: &ElementaryGrid, block: Block, acc: &mut [f64], segment: Segment, w: f64) {
     let (a_lo, b_lo, na) = (block.0, block.2, block.1 - block.0);
-    trace(grid, block, o, d, inv, r0, r1, |a, b, from, to| {
+    trace(grid, block, segment, |a, b, from, to| {
         acc[(b - b_lo) * na + (a - a_lo)] += w * (to - from);
     });
 }
