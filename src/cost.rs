@@ -8,33 +8,13 @@
 //! `c_k` is CPU milliseconds per unit on one core ([`PRECOMPUTE_MODEL`],
 //! [`PLAN_MODEL`] hold them; the tables below list the same values).
 //!
-//! **Fitted** by `taskset -c 1 cargo run --release -p vigil-loadtest
-//! --example cost_model -- --large` (about 2 minutes; it prints the refitted
-//! constants in the form below): non-negative least squares on relative
-//! error (each case's row divided by its measured time), refitted with the
-//! cases predicted low weighted twice, since predicting a little high is
-//! better than low. Data: 105 cases on this project's 2-core machine, each
-//! timed on one thread (its CPU time; the least of two passes): 74 plans
-//! (the load test's 41 workloads on `paper-v10`, `paper-v15`, `site-gates`
-//! and `site-fleet`; 30 more with 4–256 sensors, T up to 12, up to 5000
-//! targets, the paper estimator, lattices of 10⁴ and 9·10⁴ cells, circles;
-//! the 3 large plans) and 31 precomputations (900 to 4·10⁶ cells,
-//! 1–64 sources, circles of radius 15–60, several sensor types, cones).
-//!
-//! **Error**, predicted/measured on a second, independent run of the same
-//! cases (median, lowest, highest): load-test workloads 1.04 (0.90–1.23);
-//! other plans 1.01 (0.73–1.63); the large plans 0.99 (0.92–0.99);
-//! precompute 1.00 (0.94–1.34). Repeated runs of one case differ by up to
-//! ±10 %. Outside 0.85–1.25: the paper estimator with 16–256 sensors
-//! (0.73–1.52: its rounds of `iterated`, 1–9, and its area covers vary);
-//! `iterated` with 64 sensors at T = 6 (0.76) and 256 at T = 3 (1.45: one
-//! or two rounds where five are assumed); lattices of 10⁴–9·10⁴ cells
-//! with 10 sensors at T = 12 (1.36–1.63) or 64 at T = 6 (0.80); circles on
-//! a 50 × 50 lattice with one source (1.34). The precomputation (2000 × 2000 cells of 1,
-//! circles of radius 40, 64 sources around the zone) is predicted at
-//! 664 s; the same lattice with one source was predicted at 10.4 s and
-//! took 10.7 s. Predicting takes 6.5 µs for the reference workload, 0.31 ms
-//! for 256 sensors and 20 000 targets (the pairs of sensors).
+//! The coefficients are fitted from timed runs by
+//! `cargo run --release -p vigil-loadtest --example cost_model`, which
+//! prints them in the form of the two tables below; how, on what data, and
+//! how well the models predict is in `docs/performance.md` (*The cost
+//! model*). A prediction must stay cheap next to the work it predicts:
+//! O(sources + fields of view) for a precomputation, O(sensors² + targets +
+//! history) for a plan.
 //!
 //! Precompute ([`precompute_ms`]; `C` cells, per field of view):
 //!

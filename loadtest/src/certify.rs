@@ -3,7 +3,7 @@
 //!
 //! Every request is planned with each coordination asked for, one after the
 //! other, on one thread; a plan's gap is its certificate's
-//! `(upper − value) / upper` (see the main crate's README). The figures per
+//! `(upper − value) / upper` (see `docs/certified-plans.md`). The figures per
 //! coordination are the median and the 95th percentile of the gaps, and of
 //! the plan times.
 

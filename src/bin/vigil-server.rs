@@ -24,7 +24,7 @@ use vigil::store::{PgStore, Store};
 
 /// A request's JSON, its handling and its plan make some hundreds of small
 /// allocations, which mimalloc serves faster than glibc's allocator: one
-/// saturated core serves about 7 % more plans (`loadtest/README.md`).
+/// saturated core serves more plans (measured in `loadtest/README.md`).
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 

@@ -12,8 +12,7 @@ use super::error::ApiError;
 ///
 /// Written out rather than derived `via(axum::Json)`: axum parses through
 /// `serde_path_to_error`, which more than doubles the parse of a plan
-/// request (51 µs against 23 for the reference workload's, a twentieth of a
-/// plan). Here a body is parsed plainly, and only one that fails is parsed
+/// request (measured in `docs/performance.md`, *Parsing a body*). Here a body is parsed plainly, and only one that fails is parsed
 /// again by axum, for its message (which names the field's path).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Json<T>(pub T);
@@ -69,8 +68,7 @@ impl<T: serde::Serialize> axum::response::IntoResponse for Json<T> {
 /// is read (so the connection stays usable) but not parsed, and the request
 /// is shed at once with 503: under overload a shed request then costs the
 /// HTTP exchange only, not a parse and a validation of a plan that will not
-/// be made (about 0.14 ms of a core each: the more was shed, the less was
-/// served). Otherwise exactly [`Json`].
+/// be made (the more CPU shedding takes, the less is left to serve). Otherwise exactly [`Json`].
 #[derive(Debug, Clone, Copy, Default)]
 pub struct QueuedJson<T>(pub T);
 

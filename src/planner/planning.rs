@@ -294,8 +294,8 @@ fn dedup(looks: impl Iterator<Item = (Cell, usize)>) -> Vec<(Cell, usize)> {
     let mut kept: Vec<(Cell, usize)> = Vec::with_capacity(looks.size_hint().0);
     let mut seen = HashSet::new();
     for look in looks {
-        // A scan for a fleet's few looks (a hash per look cost 2 % of a
-        // plan), a set past that.
+        // A scan for a fleet's few looks (cheaper than hashing each), a
+        // set past that.
         let new = if kept.len() < 64 {
             !kept.contains(&look)
         } else {

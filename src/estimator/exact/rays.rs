@@ -14,13 +14,10 @@ use crate::stats::angular_span;
 ///
 /// The midpoint rule's error comes from the kinks of the integrand (corners
 /// of the fields of view); the cost of a plan is about linear in this number.
-/// Measured on the reference workload (`paper-v10`, 10 sensors, 16 steps of
-/// history, every cell a sensor can reach at T = 3) against 4096 rays per π,
-/// with values averaging 1.80 targets (`cargo run --release -p vigil-loadtest
-/// --example accuracy`): 96 → max 1.7e-2, mean 3.6e-3; 128 → max 1.2e-2,
-/// mean 2.2e-3 (0.12 %); 192 → 5.7e-3, 1.1e-3; 384 → 1.7e-3, 3.0e-4.
-/// 128 keeps the error under the statistical error of any realistic check
-/// (`tests/model.rs` checks against Monte Carlo) at a third of the cost of 384.
+/// 128 keeps the error against a 4,096-ray reference under the statistical
+/// error of any realistic check (`tests/model.rs` checks against Monte
+/// Carlo) at a third of the cost of 384: the measured errors per resolution
+/// are in `docs/performance.md` (*Rays per π*).
 pub const RAYS_PER_PI_SQUARE: f64 = 128.0;
 
 /// Crossings of the ray index allowed per lattice cell (about 100 bytes a
@@ -69,7 +66,8 @@ pub struct SourceRays {
 /// interval ([`slab`]; `p > q` for a ray that misses), as the seen sets
 /// compute them for a look there. The looks of a plan are such fields of
 /// view, so the seen sets read their intervals here instead, to the same
-/// bits: 0.57 → 0.49 ms a plan on the reference workload, for 3.2 MB held.
+/// bits, for a few MB held per scenario (the saving is measured in
+/// `docs/performance.md`, *Rays per π*).
 #[derive(Debug, Clone)]
 pub(super) struct LookCrossings {
     /// Per [`LookKey`]: the first ray of the range, and where its intervals
