@@ -43,7 +43,6 @@ pub struct SensorPathIn {
     /// The sensor's id, as in `sensors`.
     pub sensor: Id,
     /// Its cells at steps 1..=T.
-    #[schema(max_items = 12)]
     pub path: Vec<CellIn>,
 }
 

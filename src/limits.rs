@@ -2,7 +2,7 @@
 //!
 //! The code that checks a value, the cost model, the command line and the
 //! OpenAPI document (its bounds are written from these constants, see
-//! `http::openapi`) all read them from here, so one edit changes the limit
+//! `http::doc::bounds`) all read them from here, so one edit changes the limit
 //! everywhere. This module imports nothing: any module may use it.
 
 // The model (a scenario).
@@ -35,6 +35,8 @@ pub const MAX_SENSOR_TYPES: usize = 8;
 /// Fastest sensor, cells (king moves) per step. The search's motion tables
 /// are built for every speed up to it.
 pub const MAX_SENSOR_SPEED: usize = 3;
+/// Longest sensor type name, characters (of `[A-Za-z0-9_-]`).
+pub const MAX_TYPE_NAME_CHARS: usize = 32;
 /// Most no-go rectangles of a scenario.
 pub const MAX_NO_GO: usize = 256;
 /// Largest minimum separation accepted, cells.

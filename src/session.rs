@@ -64,7 +64,7 @@ use crate::scenario::{Integer, ValidationError};
 pub struct SessionSettings {
     /// Horizon T; the scenario's by default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(value_type = Option<u32>, minimum = 1, maximum = 12)]
+    #[schema(value_type = Option<u32>, minimum = 1)]
     pub horizon: Option<Integer>,
     /// Estimator; `exact` by default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -78,12 +78,12 @@ pub struct SessionSettings {
     /// Minimum separation between sensors, cells (0..=16); the scenario's
     /// by default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(value_type = Option<u32>, minimum = 0, maximum = 16)]
+    #[schema(value_type = Option<u32>, minimum = 0)]
     pub min_separation: Option<Integer>,
     /// Steps of history kept (0..=32, 16 by default): the sensors' past
     /// positions planned with, and how long a track lives undetected.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(value_type = Option<u32>, minimum = 0, maximum = 32)]
+    #[schema(value_type = Option<u32>, minimum = 0)]
     pub history_steps: Option<Integer>,
 }
 
@@ -107,17 +107,16 @@ impl SessionSettings {
 #[serde(deny_unknown_fields)]
 pub struct StepRequest {
     /// Sensors now.
-    #[schema(min_items = 1, max_items = 256)]
+    #[schema(min_items = 1)]
     pub sensors: Vec<SensorIn>,
     /// Targets detected this step (by any sensor), their position and
     /// displacement per step now; with an `id` when the client tracks
     /// identities.
     #[serde(default)]
-    #[schema(max_items = 20000)]
     pub detections: Vec<TargetIn>,
     /// Horizon T of this step; the session's by default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(value_type = Option<u32>, minimum = 1, maximum = 12)]
+    #[schema(value_type = Option<u32>, minimum = 1)]
     pub horizon: Option<Integer>,
     /// Estimator of this step; the session's by default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -127,7 +126,7 @@ pub struct StepRequest {
     pub coordination: Option<Coordination>,
     /// Minimum separation of this step; the session's by default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(value_type = Option<u32>, minimum = 0, maximum = 16)]
+    #[schema(value_type = Option<u32>, minimum = 0)]
     pub min_separation: Option<Integer>,
     /// Include the search values in the response.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -140,7 +139,7 @@ pub struct StepRequest {
     /// With `coordination: joint`: the most time the step's plan may take,
     /// milliseconds (1..=1000, 20 by default).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(value_type = Option<u32>, minimum = 1, maximum = 1000)]
+    #[schema(value_type = Option<u32>, minimum = 1)]
     pub budget_ms: Option<Integer>,
 }
 

@@ -15,6 +15,7 @@ use utoipa::openapi::security::{HttpAuthScheme, HttpBuilder, SecurityRequirement
 use utoipa::openapi::{Ref, RefOr};
 use utoipa::{Modify, OpenApi};
 
+use super::doc::bounds::Bounds;
 use super::doc::{
     BadPath, BuiltinScenario, InvalidEvaluateRequest, InvalidInlineEvaluateRequest,
     InvalidInlinePlanRequest, InvalidPlanRequest, InvalidScenario, InvalidSession, MalformedBody,
@@ -23,7 +24,6 @@ use super::doc::{
 };
 use super::error::Problem;
 use super::{evaluate, health, middleware, plan, scenarios, sessions};
-use crate::limits::{MAX_HISTORY_POSITIONS, MAX_SENSOR_TYPES};
 
 /// Description of the whole API, the `info.description` of the document.
 const DESCRIPTION: &str = "\
@@ -91,7 +91,7 @@ Every error is an RFC 9457 problem (`application/problem+json`, schema \
             Timeout,
         )
     ),
-    modifiers(&V1Stack, &Closed),
+    modifiers(&V1Stack, &Closed, &Bounds),
     tags(
         (name = "health", description = "Liveness."),
         (name = "scenarios", description = "Register, read and delete scenarios."),
@@ -203,13 +203,12 @@ pub async fn serve() -> impl IntoResponse {
 }
 
 /// What the derives cannot say and the server enforces: the variants of
-/// `FovSpec` admit no other fields, and a history step holds at most
-/// [`MAX_HISTORY_POSITIONS`] positions.
+/// `FovSpec` admit no other fields.
 struct Closed;
 
 impl Modify for Closed {
     fn modify(&self, doc: &mut utoipa::openapi::OpenApi) {
-        use utoipa::openapi::schema::{AdditionalProperties, ArrayItems, Schema};
+        use utoipa::openapi::schema::{AdditionalProperties, Schema};
         let Some(components) = doc.components.as_mut() else {
             return;
         };
@@ -219,37 +218,6 @@ impl Modify for Closed {
                     variant.additional_properties =
                         Some(Box::new(AdditionalProperties::FreeForm(false)));
                 }
-            }
-        }
-        // Sensor type names: a pattern and a count utoipa's derive cannot
-        // state on a map.
-        if let Some(RefOr::T(Schema::Object(spec))) = components.schemas.get_mut("ScenarioSpec")
-            && let Some(RefOr::T(Schema::Object(types))) = spec.properties.get_mut("sensor_types")
-        {
-            types.max_properties = Some(MAX_SENSOR_TYPES);
-            types.property_names = Some(Box::new(Schema::Object(
-                utoipa::openapi::schema::ObjectBuilder::new()
-                    .schema_type(utoipa::openapi::schema::Type::String)
-                    .pattern(Some("^[A-Za-z0-9_-]{1,32}$"))
-                    .build(),
-            )));
-        }
-        for name in [
-            "PlanRequest",
-            "PlanRequestById",
-            "PlanRequestWithScenario",
-            "EvaluateBody",
-            "EvaluateRequestById",
-            "EvaluateRequestWithScenario",
-        ] {
-            let Some(RefOr::T(Schema::Object(object))) = components.schemas.get_mut(name) else {
-                continue;
-            };
-            if let Some(RefOr::T(Schema::Array(history))) = object.properties.get_mut("history")
-                && let ArrayItems::RefOrSchema(step) = &mut history.items
-                && let RefOr::T(Schema::Array(step)) = step.as_mut()
-            {
-                step.max_items = Some(MAX_HISTORY_POSITIONS);
             }
         }
     }

@@ -108,7 +108,6 @@ pub struct SensorIn {
     /// Its sensor type (a name of the scenario's `sensor_types`);
     /// `default` by default.
     #[serde(rename = "type", default, skip_serializing_if = "Option::is_none")]
-    #[schema(max_length = 32)]
     pub sensor_type: Option<String>,
 }
 
@@ -140,7 +139,6 @@ pub struct PositionIn {
     /// The type of the sensor that stood there (its field of view and
     /// `p_detect`); `default` by default.
     #[serde(rename = "type", default, skip_serializing_if = "Option::is_none")]
-    #[schema(max_length = 32)]
     pub sensor_type: Option<String>,
 }
 
@@ -160,19 +158,17 @@ impl PositionIn {
 #[serde(deny_unknown_fields)]
 pub struct PlanRequest {
     /// Sensors now.
-    #[schema(min_items = 1, max_items = 256)]
+    #[schema(min_items = 1)]
     pub sensors: Vec<SensorIn>,
     /// Targets reported now.
     #[serde(default)]
-    #[schema(max_items = 20000)]
     pub targets: Vec<TargetIn>,
     /// Sensors' positions 1, 2, … steps ago (at most 256 a step).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(max_items = 32)]
     pub history: Option<Vec<Vec<PositionIn>>>,
     /// Horizon T; the scenario's by default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(value_type = Option<u32>, minimum = 1, maximum = 12)]
+    #[schema(value_type = Option<u32>, minimum = 1)]
     pub horizon: Option<Integer>,
     /// Estimator; `exact` by default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -192,7 +188,7 @@ pub struct PlanRequest {
     /// starts too close to another, or is cornered) takes the path with the
     /// fewest violations, which the response counts.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(value_type = Option<u32>, minimum = 0, maximum = 16)]
+    #[schema(value_type = Option<u32>, minimum = 0)]
     pub min_separation: Option<Integer>,
     /// With `coordination: joint`: the certified gap at which it stops, in
     /// `[0, 1]`; 0.001 by default. Other coordinations ignore it.
@@ -203,7 +199,7 @@ pub struct PlanRequest {
     /// milliseconds (1..=1000, 20 by default), counted from its start and
     /// within the server's time limit. Other coordinations ignore it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(value_type = Option<u32>, minimum = 1, maximum = 1000)]
+    #[schema(value_type = Option<u32>, minimum = 1)]
     pub budget_ms: Option<Integer>,
 }
 

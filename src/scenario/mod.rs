@@ -50,7 +50,6 @@ pub struct ZoneSpec {
 pub struct ScenarioSpec {
     /// Free-form label.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(max_length = 200)]
     pub name: Option<String>,
     /// The zone.
     pub zone: ZoneSpec,
@@ -62,7 +61,7 @@ pub struct ScenarioSpec {
     /// Speed of the type `default`, cells (king moves) per step (1..=3,
     /// default 1).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(value_type = Option<u32>, minimum = 1, maximum = 3)]
+    #[schema(value_type = Option<u32>, minimum = 1)]
     pub sensor_speed: Option<Integer>,
     /// Detection probability of the type `default`, in (0, 1] (default 1).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -75,7 +74,6 @@ pub struct ScenarioSpec {
     /// Ground no sensor may stand on: a cell whose centre lies in one of
     /// these rectangles (edges included) is blocked. Targets fly over it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(max_items = 256)]
     pub no_go: Option<Vec<NoGoSpec>>,
     /// Distance a target flies per step, for the sources that give no
     /// `speeds` (required unless every source gives them).
@@ -83,18 +81,18 @@ pub struct ScenarioSpec {
     #[schema(exclusive_minimum = 0)]
     pub target_speed: Option<f64>,
     /// Target sources (at least one).
-    #[schema(min_items = 1, max_items = 64)]
+    #[schema(min_items = 1)]
     pub sources: Vec<SourceSpec>,
     /// Default planning horizon T (1..=12, default 3).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(value_type = Option<u32>, minimum = 1, maximum = 12)]
+    #[schema(value_type = Option<u32>, minimum = 1)]
     pub horizon: Option<Integer>,
     /// Minimum separation between sensors, cells (0..=16, default 0: no
     /// rule): at every step of a plan any two sensors stand at Chebyshev
     /// distance ≥ this many cells wherever that can be kept (1: never on
     /// one cell). A plan request may override it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(value_type = Option<u32>, minimum = 0, maximum = 16)]
+    #[schema(value_type = Option<u32>, minimum = 0)]
     pub min_separation: Option<Integer>,
 }
 

@@ -14,7 +14,7 @@ use utoipa::ToSchema;
 
 use super::input::{Integer, ValidationError};
 use crate::geometry::Region;
-use crate::limits::{MAX_NO_GO, MAX_SENSOR_SPEED, MAX_SENSOR_TYPES};
+use crate::limits::{MAX_NO_GO, MAX_SENSOR_SPEED, MAX_SENSOR_TYPES, MAX_TYPE_NAME_CHARS};
 
 /// Name of the type made of the scenario's top-level `fov`.
 pub const DEFAULT_TYPE: &str = "default";
@@ -52,7 +52,7 @@ pub struct SensorTypeSpec {
     pub fov: FovSpec,
     /// Cells (king moves) per step, 1..=3; 1 by default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(value_type = Option<u32>, minimum = 1, maximum = 3)]
+    #[schema(value_type = Option<u32>, minimum = 1)]
     pub speed: Option<Integer>,
     /// Probability of detecting a target inside the field of view at a
     /// step, in (0, 1]; 1 by default.
@@ -156,7 +156,7 @@ fn check_speed(field: &str, v: Option<&Integer>) -> Result<usize, ValidationErro
 }
 
 fn valid_name(name: &str) -> bool {
-    (1..=32).contains(&name.len())
+    (1..=MAX_TYPE_NAME_CHARS).contains(&name.len())
         && name
             .bytes()
             .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-')
@@ -205,7 +205,9 @@ pub(super) fn validate_fleet(
         if !valid_name(name) {
             return Err(ValidationError::new(
                 "sensor_types",
-                format!("type name {name:?} must be 1–32 characters of [A-Za-z0-9_-]"),
+                format!(
+                    "type name {name:?} must be 1–{MAX_TYPE_NAME_CHARS} characters of [A-Za-z0-9_-]"
+                ),
             ));
         }
         if name == DEFAULT_TYPE {

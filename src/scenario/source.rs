@@ -97,7 +97,7 @@ pub struct SourceSpec {
     /// Speed distribution, 1 to 8 classes; the scenario's `target_speed`
     /// by default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schema(min_items = 1, max_items = 8)]
+    #[schema(min_items = 1)]
     pub speeds: Option<Vec<SpeedSpec>>,
 }
 

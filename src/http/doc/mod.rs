@@ -3,6 +3,7 @@
 //! example bodies. [`super::openapi`] assembles the document from them and
 //! the handlers; nothing here imports a handler.
 
+pub mod bounds;
 pub mod examples;
 mod requests;
 mod responses;

@@ -22,17 +22,15 @@ macro_rules! plan_request_with {
                 pub $field: $ty,
             )+
             /// Sensors now.
-            #[schema(min_items = 1, max_items = 256)]
+            #[schema(min_items = 1)]
             pub sensors: Vec<SensorIn>,
             /// Targets reported now.
             #[serde(default)]
-            #[schema(max_items = 20000)]
             pub targets: Vec<TargetIn>,
             /// Sensors' positions 1, 2, … steps ago (at most 256 a step).
-            #[schema(max_items = 32)]
             pub history: Option<Vec<Vec<PositionIn>>>,
             /// Horizon T; the scenario's by default.
-            #[schema(value_type = Option<u32>, minimum = 1, maximum = 12)]
+            #[schema(value_type = Option<u32>, minimum = 1)]
             pub horizon: Option<Integer>,
             /// Estimator; `exact` by default.
             pub estimator: Option<EstimatorKind>,
@@ -47,7 +45,7 @@ macro_rules! plan_request_with {
             /// default. Kept wherever it can be: a sensor that cannot keep
             /// it takes the path with the fewest violations, which the
             /// response counts.
-            #[schema(value_type = Option<u32>, minimum = 0, maximum = 16)]
+            #[schema(value_type = Option<u32>, minimum = 0)]
             pub min_separation: Option<Integer>,
             /// With `coordination: joint`: the certified gap at which it
             /// stops, in `[0, 1]`; 0.001 by default.
@@ -55,7 +53,7 @@ macro_rules! plan_request_with {
             pub gap_target: Option<f64>,
             /// With `coordination: joint`: the most time the plan may
             /// take, milliseconds (1..=1000, 20 by default).
-            #[schema(value_type = Option<u32>, minimum = 1, maximum = 1000)]
+            #[schema(value_type = Option<u32>, minimum = 1)]
             pub budget_ms: Option<Integer>,
         }
     };
@@ -93,7 +91,7 @@ plan_request_with!(
     /// part) and the paths to score.
     EvaluateBody,
     /// One path per sensor.
-    #[schema(min_items = 1, max_items = 256)]
+    #[schema(min_items = 1)]
     paths: Vec<SensorPathIn>
 );
 
@@ -104,7 +102,7 @@ plan_request_with!(
     #[schema(example = "paper-v10")]
     scenario_id: String,
     /// One path per sensor.
-    #[schema(min_items = 1, max_items = 256)]
+    #[schema(min_items = 1)]
     paths: Vec<SensorPathIn>,
 );
 
@@ -114,7 +112,7 @@ plan_request_with!(
     /// The scenario itself; precomputed on first use and cached.
     scenario: ScenarioSpec,
     /// One path per sensor.
-    #[schema(min_items = 1, max_items = 256)]
+    #[schema(min_items = 1)]
     paths: Vec<SensorPathIn>,
 );
 
@@ -139,7 +137,7 @@ macro_rules! session_request_with {
             $(#[$field_doc])*
             pub $field: $ty,
             /// Horizon T of its steps; the scenario's by default.
-            #[schema(value_type = Option<u32>, minimum = 1, maximum = 12)]
+            #[schema(value_type = Option<u32>, minimum = 1)]
             pub horizon: Option<Integer>,
             /// Estimator of its steps; `exact` by default.
             pub estimator: Option<EstimatorKind>,
@@ -149,12 +147,12 @@ macro_rules! session_request_with {
             pub observed: Option<Observed>,
             /// Minimum separation of its steps, cells (0..=16); the
             /// scenario's by default.
-            #[schema(value_type = Option<u32>, minimum = 0, maximum = 16)]
+            #[schema(value_type = Option<u32>, minimum = 0)]
             pub min_separation: Option<Integer>,
             /// Steps of history kept (0..=32, 16 by default): the sensors'
             /// past positions planned with, and how long a track lives
             /// undetected.
-            #[schema(value_type = Option<u32>, minimum = 0, maximum = 32)]
+            #[schema(value_type = Option<u32>, minimum = 0)]
             pub history_steps: Option<Integer>,
         }
     };
