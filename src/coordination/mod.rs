@@ -51,6 +51,7 @@
 pub mod certificate;
 mod fleet;
 pub mod joint;
+mod priority;
 mod rounds;
 
 use std::time::Instant;
@@ -62,13 +63,15 @@ use utoipa::ToSchema;
 use crate::cancel::Cancelled;
 use crate::scenario::Cell;
 use crate::search::ValueGrid;
-use crate::separation::{self, Violations, mark_too_close};
+use crate::separation::{self, Violations};
 
 pub use certificate::Bound;
 use certificate::Certifier;
+use fleet::path_slices;
 pub use fleet::{Fleet, SensorPlan, path_moves, sensor_motion};
-use fleet::{path_slices, search};
 pub use joint::{JointReport, JointSettings};
+pub use priority::MAX_REPAIRS;
+use priority::Ranking;
 pub use rounds::MAX_ROUNDS;
 
 /// How sensors' searches are coordinated.
@@ -86,9 +89,6 @@ pub enum Coordination {
     /// or the time budget runs out.
     Joint,
 }
-
-/// Largest number of repair rounds of the separation.
-pub const MAX_REPAIRS: usize = 8;
 
 /// Plans of every sensor, in request order, with their ranks.
 #[derive(Debug, Clone)]
@@ -135,14 +135,6 @@ pub fn coordinate(
         ..
     } = *fleet;
     let n = starts.len();
-    // The paths of `sensors`, when there is a separation to keep.
-    let paths =
-        |plans: &[SensorPlan], sensors: &mut dyn Iterator<Item = usize>| -> Vec<Vec<Cell>> {
-            if d == 0 {
-                return Vec::new();
-            }
-            sensors.map(|q| plans[q].path.clone()).collect()
-        };
     // Every sensor alone.
     let mut plans: Vec<SensorPlan> = (0..n)
         .into_par_iter()
@@ -154,91 +146,28 @@ pub fn coordinate(
     let mut order: Vec<usize> = (0..n).collect();
     // Stable sort: ties keep request order.
     order.sort_by(|&a, &b| plans[b].value.total_cmp(&plans[a].value));
-    // Each sensor's lone values: without coordination but apart it keeps
-    // them, and at a step where no higher-ranked look comes near its reach
-    // its values against them are these (the same fill, of no looks).
-    // An exact plan's certificate starts from them too.
+    // Each sensor's lone values, which the later passes start from; an
+    // exact plan's certificate starts from them too.
     let alone: Vec<ValueGrid> = if mode != Coordination::None || d > 0 || est.order_independent() {
         plans.iter().map(|p| p.grid.clone()).collect()
     } else {
         Vec::new()
     };
-    // The priority pass's search of the sensor ranked `rank`: its values
-    // against the sensors ranked above it (its lone values without
-    // coordination), around the paths of those sensors, or of every other
-    // sensor when `around_all`.
-    let ranked = |plans: &[SensorPlan], rank: usize, around_all: bool| -> SensorPlan {
-        let i = order[rank];
-        let above = &order[..rank];
-        let avoid = if around_all {
-            paths(plans, &mut (0..n).filter(|&j| j != i))
-        } else {
-            paths(plans, &mut above.iter().copied())
-        };
-        let avoid = avoid.iter().map(Vec::as_slice).collect();
-        if mode == Coordination::None {
-            let mut grid = alone[i].clone();
-            mark_too_close(&mut grid, starts[i], d, avoid);
-            search(grid, starts[i])
-        } else {
-            let looks = fleet.looks_by_step(&path_slices(plans), above, i);
-            fleet.plan_one(
-                i,
-                &mut |t, g| match &looks[t - 1][..] {
-                    [] => g.copy_step(t, &alone[i]),
-                    near => est.fill(i, starts[i], t, near, g),
-                },
-                avoid,
-            )
-        }
+    let ranking = Ranking {
+        fleet,
+        order,
+        alone: &alone,
+        independent: mode == Coordination::None,
     };
     let mut rounds = 0;
     let mut repairs = 0;
     if mode != Coordination::None || d > 0 {
-        // Priority: each sensor against the ones above it, in rank order.
-        for rank in 1..n {
-            plans[order[rank]] = ranked(&plans, rank, false);
-            cancel.check()?;
-        }
+        ranking.priority_pass(&mut plans)?;
     }
     if d > 0 {
-        // Repair: a higher-ranked sensor may have cornered a lower one,
-        // which the pass above never revisits. The highest-ranked sensor
-        // too close to another that can have fewer violations against every
-        // other path takes that path, the ranks below it plan again in
-        // order, and the change stays if fewer pairs are too close.
-        let mut total = separation::count(&path_slices(&plans), d);
-        while total.pairs > 0 && repairs < MAX_REPAIRS {
-            repairs += 1;
-            let mut improved = false;
-            for rank in 0..n {
-                let i = order[rank];
-                if total.per_sensor[i] == 0 {
-                    continue;
-                }
-                let candidate = ranked(&plans, rank, true);
-                cancel.check()?;
-                if candidate.violations >= total.per_sensor[i] {
-                    continue;
-                }
-                let mut trial = plans.clone();
-                trial[i] = candidate;
-                for below in rank + 1..n {
-                    trial[order[below]] = ranked(&trial, below, false);
-                    cancel.check()?;
-                }
-                let after = separation::count(&path_slices(&trial), d);
-                if after.pairs < total.pairs {
-                    (plans, total) = (trial, after);
-                    improved = true;
-                    break;
-                }
-            }
-            if !improved {
-                break;
-            }
-        }
+        repairs = ranking.repair(&mut plans)?;
     }
+    let order = ranking.order;
     if matches!(mode, Coordination::Iterated | Coordination::Joint) {
         rounds = rounds::best_responses(fleet, &mut plans, &order, MAX_ROUNDS, None)?.rounds;
     }
