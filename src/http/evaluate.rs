@@ -10,12 +10,11 @@ use super::doc::{self, examples};
 use super::error::ApiError;
 use super::extract::{Json, Path, QueuedJson};
 use super::middleware::RequestStart;
-use super::planning::{CancelOnDrop, with_scenario};
+use super::planning::{CancelOnDrop, refuse_if_costly, with_scenario};
 use super::state::AppState;
 use crate::coordination::Coordination;
 use crate::cost;
 use crate::evaluate::{EvaluateInput, EvaluateRequest, EvaluateResponse};
-use crate::metric_names;
 use crate::planner::Planner;
 
 /// Validates `req`, refuses it past the plan cost limit, and scores it on
@@ -32,15 +31,7 @@ async fn evaluate_admitted(
     let mut uncoordinated = input.plan.clone();
     uncoordinated.coordination = Coordination::None;
     let predicted_ms = cost::plan_ms(&planner, &uncoordinated);
-    if let Some(limit_ms) = state.settings.max_plan_ms
-        && predicted_ms > limit_ms
-    {
-        metrics::counter!(metric_names::PLANS_REFUSED_TOTAL, "reason" => "cost").increment(1);
-        return Err(ApiError::PlanTooCostly {
-            predicted_ms,
-            limit_ms,
-        });
-    }
+    refuse_if_costly(state, predicted_ms)?;
     let guard = CancelOnDrop::new("evaluate", start, state);
     let token = guard.token();
     let res = super::queue::on_rayon(move || planner.evaluate(&input, &token)).await;

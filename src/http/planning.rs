@@ -74,6 +74,24 @@ impl Drop for CancelOnDrop {
     }
 }
 
+/// Refuses work predicted to take more than the server's `--max-plan-ms`
+/// of CPU, before any of it starts (422), and counts the refusal.
+///
+/// # Errors
+/// [`ApiError::PlanTooCostly`] past the limit.
+pub(super) fn refuse_if_costly(state: &AppState, predicted_ms: f64) -> Result<(), ApiError> {
+    if let Some(limit_ms) = state.settings.max_plan_ms
+        && predicted_ms > limit_ms
+    {
+        metrics::counter!(metric_names::PLANS_REFUSED_TOTAL, "reason" => "cost").increment(1);
+        return Err(ApiError::PlanTooCostly {
+            predicted_ms,
+            limit_ms,
+        });
+    }
+    Ok(())
+}
+
 /// Validates `req`, refuses it if its predicted cost is above the limit,
 /// and plans it once admitted to the planning queue: on rayon, cancelled as
 /// soon as nobody waits for it, or (a short plan on a server that plans
@@ -86,15 +104,7 @@ pub(super) async fn plan_admitted(
 ) -> Result<PlanResponse, ApiError> {
     let input = PlanInput::new(&planner.scenario, req)?;
     let predicted_ms = cost::plan_ms(&planner, &input);
-    if let Some(limit_ms) = state.settings.max_plan_ms
-        && predicted_ms > limit_ms
-    {
-        metrics::counter!(metric_names::PLANS_REFUSED_TOTAL, "reason" => "cost").increment(1);
-        return Err(ApiError::PlanTooCostly {
-            predicted_ms,
-            limit_ms,
-        });
-    }
+    refuse_if_costly(state, predicted_ms)?;
     let guard = CancelOnDrop::new("plan", start, state);
     let token = guard.token();
     let res = if state.settings.plans_inline() && predicted_ms <= INLINE_PLAN_MS {
