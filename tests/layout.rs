@@ -6,11 +6,17 @@
 //! trees (braces expanded) and inline paths that start with `crate::`,
 //! `super::`, `self::` or the name of a child module it declares. A path
 //! counts for the longest module prefix it names, so `crate::a::b::Item`
-//! is an edge to `a::b` when that file exists and to `a` otherwise. Declaring
-//! a child (`mod b;`) is not an edge, nor is re-exporting its items (`pub use
-//! b::Item`: a facade names them, it does not depend on them); but a parent
-//! whose code uses a child while the child reaches back into the parent's
-//! own items makes a circle, so items both need live in a leaf they import.
+//! is an edge to `a::b` when that file exists and to `a` otherwise, unless
+//! `a` re-exports `Item`: then the edge goes on to where the re-export leads
+//! (a glob: every module it names), so importing through a facade is
+//! importing from the module that defines the item. Declaring a child (`mod
+//! b;`) is not an edge, nor is re-exporting its items (`pub use b::Item`: a
+//! facade names them, it does not depend on them); but a parent whose code
+//! uses a child while the child reaches back into the parent's own items
+//! makes a circle, so items both need live in a leaf they import. A renamed
+//! re-export (`pub use b::X as Y`) is known by its old name.
+//! A name brought in by a `use` (`use crate::catalog;`) starts paths that
+//! count as the full path (`catalog::Registry` is `crate::catalog::Registry`).
 //! Inside an inline module (`mod tests { … }`) `super::` is the file
 //! itself. Comments are skipped.
 #![allow(clippy::unwrap_used, missing_docs)]
@@ -163,6 +169,7 @@ fn use_tree(t: &[Token], i: &mut usize, prefix: &[String], out: &mut Vec<Vec<Str
                 return;
             }
             Some(Token::Punct('*')) => {
+                path.push("*".into());
                 *i += 1;
             }
             _ => {}
@@ -179,11 +186,19 @@ fn use_tree(t: &[Token], i: &mut usize, prefix: &[String], out: &mut Vec<Vec<Str
     }
 }
 
-/// Every path the tokens name: `use` trees and inline `a::b::c` chains.
-/// A re-export (`pub use`, `pub(crate) use`) is left out: it is the
-/// module's public face, not something its code depends on.
-fn paths(t: &[Token]) -> Vec<Vec<String>> {
-    let mut out = Vec::new();
+/// The paths a file names: what its code uses, and what it re-exports.
+#[derive(Debug, Default)]
+struct Named {
+    /// `use` trees and inline `a::b::c` chains (a glob ends in `*`).
+    uses: Vec<Vec<String>>,
+    /// The trees of `pub use` and `pub(…) use`: the module's public face,
+    /// which leads an importer on to where an item is defined.
+    reexports: Vec<Vec<String>>,
+}
+
+/// Every path the tokens name.
+fn paths(t: &[Token]) -> Named {
+    let mut out = Named::default();
     let mut i = 0;
     while i < t.len() {
         match &t[i] {
@@ -195,8 +210,10 @@ fn paths(t: &[Token]) -> Vec<Vec<String>> {
                 i += 1;
                 let mut tree = Vec::new();
                 use_tree(t, &mut i, &[], &mut tree);
-                if !reexport {
-                    out.extend(tree);
+                if reexport {
+                    out.reexports.extend(tree);
+                } else {
+                    out.uses.extend(tree);
                 }
             }
             Token::Ident(s) if matches!(t.get(i + 1), Some(Token::Path)) => {
@@ -207,7 +224,7 @@ fn paths(t: &[Token]) -> Vec<Vec<String>> {
                     path.push(n.clone());
                     i += 2;
                 }
-                out.push(path);
+                out.uses.push(path);
             }
             _ => i += 1,
         }
@@ -235,32 +252,63 @@ fn children(t: &[Token]) -> BTreeSet<String> {
         .collect()
 }
 
-/// The module `path` names from `here`, by its longest module prefix.
-fn resolve(
-    modules: &BTreeSet<Module>,
-    here: &Module,
-    kids: &BTreeSet<String>,
-    path: &[String],
-) -> Option<Module> {
-    let (mut base, mut rest): (Module, &[String]) = match path.first()?.as_str() {
+/// What the files declare, module by module.
+struct Crate {
+    modules: BTreeSet<Module>,
+    /// Per module: the children it declares (`mod name;`).
+    kids: BTreeMap<Module, BTreeSet<String>>,
+    /// Per module: its re-exports' paths (the last segment is the name, or
+    /// `*` for a glob).
+    reexports: BTreeMap<Module, Vec<Vec<String>>>,
+}
+
+/// The modules `path` names from `here`: its longest module prefix, and
+/// where a re-export there leads (a glob: every module it re-exports).
+/// Paths that start elsewhere (an outside crate, a local name) name none.
+fn resolve(c: &Crate, here: &Module, path: &[String], depth: usize) -> Vec<Module> {
+    let Some(first) = path.first() else {
+        return Vec::new();
+    };
+    let (mut base, mut rest): (Module, &[String]) = match first.as_str() {
         "crate" => (Vec::new(), &path[1..]),
         "self" => (here.clone(), &path[1..]),
         "super" => (here.clone(), path),
-        child if kids.contains(child) => (here.clone(), path),
-        _ => return None,
+        child if c.kids.get(here).is_some_and(|k| k.contains(child)) => (here.clone(), path),
+        _ => return Vec::new(),
     };
     while rest.first().is_some_and(|s| s == "super") {
         base.pop();
         rest = &rest[1..];
     }
-    for seg in rest {
-        base.push(seg.clone());
-        if !modules.contains(&base) {
-            base.pop();
-            break;
+    while let Some((seg, tail)) = rest.split_first() {
+        let mut next = base.clone();
+        next.push(seg.clone());
+        if c.modules.contains(&next) {
+            (base, rest) = (next, tail);
+            continue;
         }
+        // An item of `base`: if `base` re-exports it, the importer depends
+        // on where it is defined.
+        let reexports = c.reexports.get(&base).map_or(&[][..], Vec::as_slice);
+        let named: Vec<&Vec<String>> = reexports.iter().filter(|p| p.last() == Some(seg)).collect();
+        let via: Vec<&[String]> = if named.is_empty() {
+            reexports
+                .iter()
+                .filter(|p| p.last().is_some_and(|l| l == "*"))
+                .map(|p| &p[..p.len() - 1])
+                .collect()
+        } else {
+            named.iter().map(|p| p.as_slice()).collect()
+        };
+        if depth < 8 && !via.is_empty() {
+            return via
+                .iter()
+                .flat_map(|p| resolve(c, &base, p, depth + 1))
+                .collect();
+        }
+        break;
     }
-    Some(base)
+    vec![base]
 }
 
 fn graph(src: &Path) -> BTreeMap<Module, BTreeSet<Module>> {
@@ -270,26 +318,45 @@ fn graph(src: &Path) -> BTreeMap<Module, BTreeSet<Module>> {
         .iter()
         .filter_map(|f| Some((module_of(src, f)?, tokens(&fs::read_to_string(f).unwrap()))))
         .collect();
-    let modules: BTreeSet<Module> = parsed.iter().map(|(m, _)| m.clone()).collect();
+    let split = |t: &[Token]| inline_module_start(t).unwrap_or(t.len());
+    let c = Crate {
+        modules: parsed.iter().map(|(m, _)| m.clone()).collect(),
+        kids: parsed
+            .iter()
+            .map(|(m, t)| (m.clone(), children(t)))
+            .collect(),
+        reexports: parsed
+            .iter()
+            .map(|(m, t)| (m.clone(), paths(&t[..split(t)]).reexports))
+            .collect(),
+    };
     let mut edges = BTreeMap::new();
     for (here, t) in &parsed {
-        let kids = children(t);
-        let split = inline_module_start(t).unwrap_or(t.len());
+        let at = split(t);
         let mut to = BTreeSet::new();
-        let file_level = paths(&t[..split]);
+        let file_level = paths(&t[..at]).uses;
         // Inside an inline module `super` is this file: read it as `self`.
-        let inner = paths(&t[split..]).into_iter().map(|mut p| {
+        let inner = paths(&t[at..]).uses.into_iter().map(|mut p| {
             if p.first().is_some_and(|s| s == "super") {
                 p[0] = "self".into();
             }
             p
         });
-        for p in file_level.into_iter().chain(inner) {
-            if let Some(m) = resolve(&modules, here, &kids, &p)
-                && m != *here
-            {
-                to.insert(m);
-            }
+        // A name a `use` brought in (`use crate::catalog;`) starts paths
+        // of its own (`catalog::Registry`): read them as the full path.
+        let aliases: BTreeMap<String, Vec<String>> = file_level
+            .iter()
+            .filter(|p| p.len() > 1 && p.last().is_some_and(|l| l != "*"))
+            .filter_map(|p| Some((p.last()?.clone(), p.clone())))
+            .collect();
+        for p in file_level.iter().cloned().chain(inner) {
+            let p = match p.first().and_then(|f| aliases.get(f)) {
+                Some(full) if p.len() > 1 && !c.kids[here].contains(&p[0]) => {
+                    [full.as_slice(), &p[1..]].concat()
+                }
+                _ => p,
+            };
+            to.extend(resolve(&c, here, &p, 0).into_iter().filter(|m| m != here));
         }
         edges.insert(here.clone(), to);
     }
@@ -386,16 +453,60 @@ fn a_circle_is_found_and_a_tree_is_not() {
 #[test]
 fn use_trees_expand_and_inline_modules_read_super_as_self() {
     let t = tokens("use crate::{a::{B, c::D as E}, f}; use super::g::*; x::y::z(); // crate::no\n");
-    let p = paths(&t);
+    let p = paths(&t).uses;
     let s = |v: &[&str]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>();
     assert!(p.contains(&s(&["crate", "a", "B"])));
     assert!(p.contains(&s(&["crate", "a", "c", "D"])));
     assert!(p.contains(&s(&["crate", "f"])));
-    assert!(p.contains(&s(&["super", "g"])));
+    assert!(p.contains(&s(&["super", "g", "*"])));
     assert!(p.contains(&s(&["x", "y", "z"])));
     assert!(!p.iter().any(|q| q.contains(&"no".to_string())));
-    let t = tokens("pub use a::B; pub(crate) use c::D; use e::F;");
-    assert_eq!(paths(&t), vec![s(&["e", "F"])]);
+    let t = tokens("pub use a::B; pub(crate) use c::*; use e::F;");
+    let named = paths(&t);
+    assert_eq!(named.uses, vec![s(&["e", "F"])]);
+    assert_eq!(named.reexports, vec![s(&["a", "B"]), s(&["c", "*"])]);
     let t = tokens("mod inner { use super::Thing; }");
     assert_eq!(inline_module_start(&t), Some(0));
+}
+
+/// An import through a facade's re-export depends on the module that
+/// defines the item, so a circle through a facade is still found.
+#[test]
+fn re_exports_lead_to_where_an_item_is_defined() {
+    let m = |s: &str| -> Module {
+        if s.is_empty() {
+            Vec::new()
+        } else {
+            s.split("::").map(String::from).collect()
+        }
+    };
+    let p = |s: &str| -> Vec<String> { s.split("::").map(String::from).collect() };
+    let c = Crate {
+        modules: ["", "a", "a::b", "a::g", "c"].into_iter().map(m).collect(),
+        kids: [
+            (m(""), BTreeSet::from(["a".to_string(), "c".to_string()])),
+            (m("a"), BTreeSet::from(["b".to_string(), "g".to_string()])),
+        ]
+        .into_iter()
+        .collect(),
+        reexports: [(m("a"), vec![p("b::Item"), p("g::*")])]
+            .into_iter()
+            .collect(),
+    };
+    assert_eq!(
+        resolve(&c, &m("c"), &p("crate::a::Item"), 0),
+        vec![m("a::b")]
+    );
+    assert_eq!(
+        resolve(&c, &m("c"), &p("crate::a::Other"), 0),
+        vec![m("a::g")]
+    );
+    assert_eq!(
+        resolve(&c, &m("c"), &p("crate::a::b::Item"), 0),
+        vec![m("a::b")]
+    );
+    assert_eq!(
+        resolve(&c, &m("c"), &p("std::fmt"), 0),
+        Vec::<Module>::new()
+    );
 }
