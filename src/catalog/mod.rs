@@ -9,7 +9,7 @@
 //!   pools and the background jobs;
 //! - [`cache`]: planners bounded by memory (inline scenarios, and the
 //!   PostgreSQL catalogue's scenarios used here);
-//! - [`watch`]: following deletions made through other replicas;
+//! - `watch`: following deletions made through other replicas;
 //! - [`error`]: what it fails with ([`CatalogError`]).
 //!
 //! It is plain domain code: the HTTP layer maps [`CatalogError`] to its

@@ -281,7 +281,7 @@ impl<'f, 'a> Relaxation<'f, 'a> {
     }
 
     /// Takes `upper` as `U` at the current weights, with its maximising
-    /// `paths`: Polyak's step length `λ` halves after [`STALL`] values in a
+    /// `paths`: Polyak's step length `λ` halves after `STALL` values in a
     /// row that found no smaller bound.
     pub fn record(&mut self, upper: f64, paths: Vec<Vec<Cell>>) {
         if upper < self.best {

@@ -115,7 +115,7 @@ pub struct Coordinated {
 /// speed through the scenario's free cells, and keeps the fleet's minimum
 /// separation from the others wherever it can (see the module docs). With
 /// an order-independent (exact) estimator the plan carries its
-/// [certificate](certificate).
+/// [certificate].
 ///
 /// # Errors
 /// [`Cancelled`] once the fleet's token is cancelled: it is checked before

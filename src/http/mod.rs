@@ -4,7 +4,8 @@
 //! only binds and serves it. Every error is an [`ApiError`], rendered as
 //! `application/problem+json`. CPU work runs off the async workers: plans on
 //! rayon's global pool, at most one per worker at a time ([`on_rayon`]), and
-//! scenario precomputation on a pool of its own ([`precompute`]).
+//! scenario precomputation on a pool of its own
+//! ([`precompute`](crate::catalog::precompute)).
 //!
 //! | Method | Path | Success |
 //! |---|---|---|

@@ -109,7 +109,7 @@ const RULES: &[(&[&str], &str, Bound)] = &[
     ),
 ];
 
-/// Writes every bound of [`RULES`], and the count and the name pattern of a
+/// Writes every bound of `RULES`, and the count and the name pattern of a
 /// scenario's sensor types (a map, which the derive cannot bound).
 #[derive(Debug)]
 pub struct Bounds;
