@@ -43,35 +43,27 @@ fn main() {
                     vel: Point::new(t.vx, t.vy),
                 })
                 .collect();
-            let a = ExactEstimator::new(
-                Precomputed {
-                    scenario: &s,
-                    stats: std::slice::from_ref(&stats),
-                    rays: &rays,
-                    grid: grid.as_ref(),
-                },
-                Situation {
-                    observed: &observed,
-                    targets: &targets,
-                    starts: &starts,
-                    types: &vec![0; starts.len()],
-                    horizon: 3,
-                },
-            );
+            let types = vec![0; starts.len()];
+            let now = Situation {
+                observed: &observed,
+                targets: &targets,
+                starts: &starts,
+                types: &types,
+                horizon: 3,
+            };
+            let coarse = Precomputed {
+                scenario: &s,
+                stats: std::slice::from_ref(&stats),
+                rays: &rays,
+                grid: grid.as_ref(),
+            };
+            let a = ExactEstimator::new(coarse, now);
             let b = ExactEstimator::new(
                 Precomputed {
-                    scenario: &s,
-                    stats: std::slice::from_ref(&stats),
                     rays: &fine,
-                    grid: grid.as_ref(),
+                    ..coarse
                 },
-                Situation {
-                    observed: &observed,
-                    targets: &targets,
-                    starts: &starts,
-                    types: &vec![0; starts.len()],
-                    horizon: 3,
-                },
+                now,
             );
             for (i, &c) in starts.iter().enumerate() {
                 for t in 1..=3 {
