@@ -68,8 +68,10 @@ use std::sync::Arc;
 
 use crate::limits::MAX_SENSOR_SPEED;
 
+mod bound;
 mod motion;
 
+pub use bound::{Bounded, PathGain, best_path_bounded};
 use motion::Motion;
 pub use motion::{MOVES, step_displacements};
 

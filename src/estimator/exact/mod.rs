@@ -5,6 +5,7 @@
 //! (seen sets along rays), [`windows`] (per-step unseen mass over the
 //! elementary grid) and, here, the per-cell values.
 
+mod first;
 mod rays;
 mod seen;
 #[cfg(test)]
@@ -13,6 +14,7 @@ mod windows;
 
 use rayon::prelude::*;
 
+pub use first::{FirstDetections, PathCover};
 use rays::{ClassRays, LookKey, look_key};
 pub use rays::{
     INDEX_CROSSINGS_PER_CELL, MIN_INDEX_CROSSINGS, RAYS_PER_PI, RAYS_PER_PI_SQUARE, SourceRays,

@@ -1,0 +1,435 @@
+//! The intrusion objective: the expected number of targets not yet
+//! detected that a plan detects at least once ("first detections").
+//!
+//! A target that no sensor has detected (unseen in the history, as the
+//! exact estimator's unseen part defines it) flies along a ray from its
+//! source. Put it by its distance `r` from the source at step 0 (negative
+//! for a target not yet emitted): at step `t` it is at `r + v·t`. A look at
+//! step `t` that holds the interval `[a, b]` of the ray therefore holds the
+//! targets with `r ∈ [a − v·t, b − v·t]`: its *piece*, pulled back to step 0.
+//! Along each (class, ray) the targets are spread with the constant density
+//! `λ_c/(spread·v_c)` per unit of `r` (the class's ray weight), each still
+//! undetected with probability `u(r) = Π (1 − p)` over the history's looks
+//! that held it (see `seen`). A plan detects it at least once with
+//! probability `1 − Π (1 − p)` over the plan's pieces that hold `r`, so the
+//! objective is, per (class, ray), `∫ u(r) (1 − Π_plan (1 − p)) dr`, summed
+//! with the ray weights (the midpoint rule in angle, as everywhere in the
+//! exact estimator). Writing `D(X) = ∫ 1 − Π_X (1 − p)`, it is
+//! `D(history ∪ plan) − D(history)` over the plan's pieces: interval
+//! arithmetic, exact along each ray.
+//!
+//! The objective is a weighted coverage: monotone in the looks and
+//! submodular, so a look adds at most what it adds alone (the upper bound
+//! that [`crate::search::best_path_bounded`] prunes with), and the
+//! certificate's marginal bound holds for it.
+
+use super::ExactEstimator;
+use crate::geometry::{Point, detection_pieces, detection_within};
+use crate::scenario::{Cell, Look};
+use crate::search::{PathGain, ValueGrid};
+
+/// A look's interval on one (class, ray), pulled back to step 0.
+#[derive(Debug, Clone, Copy)]
+struct Piece {
+    /// The (class, ray) pair: `key_start[class] + ray`.
+    key: u32,
+    a: f64,
+    b: f64,
+    /// The look's detection probability.
+    p: f64,
+    /// The class's ray weight: targets per unit of `r`.
+    w: f64,
+}
+
+/// Per key, sorted disjoint pieces `(x0, x1, detected)` of a ray, and the
+/// detected length before each within its key: what is already detected
+/// (or, for a search, detected or counted by another sensor).
+#[derive(Debug, Default)]
+struct Profile {
+    /// `pieces[start[i]..start[i + 1]]` belong to the `i`-th key listed.
+    start: Vec<u32>,
+    pieces: Vec<(f64, f64, f64)>,
+    /// Aligned with `pieces`: `Σ (x1 − x0)·detected` of the key's earlier
+    /// pieces.
+    before: Vec<f64>,
+}
+
+impl Profile {
+    /// Appends one key's sorted disjoint pieces.
+    fn push_key(&mut self, pieces: impl IntoIterator<Item = (f64, f64, f64)>) {
+        if self.start.is_empty() {
+            self.start.push(0);
+        }
+        let mut acc = 0.0;
+        for (x0, x1, d) in pieces {
+            self.pieces.push((x0, x1, d));
+            self.before.push(acc);
+            acc += (x1 - x0) * d;
+        }
+        self.start.push(self.pieces.len() as u32);
+    }
+
+    /// The `i`-th key's pieces.
+    fn of(&self, i: usize) -> &[(f64, f64, f64)] {
+        &self.pieces[self.start[i] as usize..self.start[i + 1] as usize]
+    }
+
+    /// `∫_a^b detected` over the `i`-th key's pieces.
+    fn detected(&self, i: usize, a: f64, b: f64) -> f64 {
+        let lo = self.start[i] as usize;
+        let pieces = &self.pieces[lo..self.start[i + 1] as usize];
+        let before = &self.before[lo..self.start[i + 1] as usize];
+        let upto = |x: f64| -> f64 {
+            // The first piece that ends after x.
+            let j = pieces.partition_point(|p| p.1 <= x);
+            match pieces.get(j) {
+                Some(&(x0, _, d)) if x > x0 => before[j] + (x - x0) * d,
+                Some(_) => before[j],
+                None => pieces
+                    .last()
+                    .map_or(0.0, |&(x0, x1, d)| before[pieces.len() - 1] + (x1 - x0) * d),
+            }
+        };
+        if pieces.is_empty() || b <= a {
+            return 0.0;
+        }
+        upto(b) - upto(a)
+    }
+}
+
+/// What is detected already, per key: the history's seen sets, and over
+/// them, for the keys some extra look meets, the extra looks' pieces.
+#[derive(Debug)]
+struct Background<'h> {
+    history: &'h Profile,
+    /// Sorted keys with extra pieces, and their merged profiles.
+    keys: Vec<u32>,
+    merged: Profile,
+}
+
+impl Background<'_> {
+    /// `∫_a^b detected` on `key`.
+    fn detected(&self, key: u32, a: f64, b: f64) -> f64 {
+        match self.keys.binary_search(&key) {
+            Ok(i) => self.merged.detected(i, a, b),
+            Err(_) => self.history.detected(key as usize, a, b),
+        }
+    }
+}
+
+/// The first-detections objective of one exact estimator's situation (see
+/// the module docs): plans' values, and each sensor's path gains for the
+/// search.
+pub struct FirstDetections<'e> {
+    est: &'e ExactEstimator<'e>,
+    /// Per class, its first key (and one past the last class's keys).
+    key_start: Vec<u32>,
+    /// Per source's rays (the estimator's `rays`), its classes.
+    classes_of_rays: Vec<std::ops::Range<usize>>,
+    /// The history's seen sets, one key each.
+    history: Profile,
+}
+
+impl<'e> FirstDetections<'e> {
+    /// The objective over `est`'s history: what its seen sets hold is
+    /// detected already.
+    pub fn new(est: &'e ExactEstimator<'e>) -> Self {
+        let mut key_start = Vec::with_capacity(est.classes.len() + 1);
+        let mut next = 0u32;
+        for c in &est.classes {
+            key_start.push(next);
+            next += est.rays[c.rays].dirs.len() as u32;
+        }
+        key_start.push(next);
+        let classes_of_rays = (0..est.rays.len())
+            .map(|ri| {
+                let first = est.classes.iter().position(|c| c.rays == ri);
+                let count = est.classes.iter().filter(|c| c.rays == ri).count();
+                first.map_or(0..0, |f| f..f + count)
+            })
+            .collect();
+        let mut history = Profile::default();
+        for (c, hits) in est.classes.iter().zip(&est.seen) {
+            for m in 0..est.rays[c.rays].dirs.len() {
+                let (iv, det) = (hits.of(m), hits.detected(m));
+                history.push_key(
+                    iv.iter()
+                        .enumerate()
+                        .map(|(i, &(a, b))| (a, b, if det.is_empty() { 1.0 } else { det[i] })),
+                );
+            }
+        }
+        if history.start.is_empty() {
+            history.start.push(0);
+        }
+        Self {
+            est,
+            key_start,
+            classes_of_rays,
+            history,
+        }
+    }
+
+    /// Appends the pieces of `look` taken at step `t`, sorted by key.
+    fn pieces(&self, look: &Look, t: usize, out: &mut Vec<Piece>, buf: &mut Vec<Point>) {
+        let mut on_rays: Vec<(u32, f64, f64)> = Vec::new();
+        for (ri, sr) in self.est.rays.iter().enumerate() {
+            let classes = self.classes_of_rays[ri].clone();
+            if classes.is_empty() {
+                continue;
+            }
+            let Some((a, b)) = sr.range(&look.region, buf) else {
+                continue;
+            };
+            on_rays.clear();
+            on_rays.extend((a..b).filter_map(|m| {
+                let (d, inv) = sr.dirs[m];
+                let (lo, hi) = look.region.ray(sr.source.pos, d, inv)?;
+                (hi > lo).then_some((m as u32, lo, hi))
+            }));
+            for c in classes {
+                let class = &self.est.classes[c];
+                let shift = class.speed * t as f64;
+                out.extend(on_rays.iter().map(|&(m, lo, hi)| Piece {
+                    key: self.key_start[c] + m,
+                    a: lo - shift,
+                    b: hi - shift,
+                    p: look.p_detect,
+                    w: class.weight,
+                }));
+            }
+        }
+    }
+
+    /// Expected first detections of `looks` (`looks[t − 1]`: every look
+    /// taken at step `t`), per step: the targets not yet detected that some
+    /// look of step `t` detects and no look of an earlier step did.
+    pub fn by_step(&self, looks: &[Vec<Look>]) -> Vec<f64> {
+        let horizon = looks.len();
+        let mut buf = Vec::new();
+        // (step, piece), sorted by key then step.
+        let mut all: Vec<(usize, Piece)> = Vec::new();
+        let mut one = Vec::new();
+        for (t, step) in looks.iter().enumerate() {
+            for look in step {
+                one.clear();
+                self.pieces(look, t + 1, &mut one, &mut buf);
+                all.extend(one.iter().map(|&p| (t + 1, p)));
+            }
+        }
+        all.sort_by(|x, y| x.1.key.cmp(&y.1.key).then(x.0.cmp(&y.0)));
+        let mut by_step = vec![0.0; horizon];
+        let mut intervals: Vec<(f64, f64, f64)> = Vec::new();
+        let mut events = Vec::new();
+        for group in all.chunk_by(|x, y| x.1.key == y.1.key) {
+            let key = group[0].1.key as usize;
+            let w = group[0].1.w;
+            let lo = group.iter().map(|x| x.1.a).fold(f64::INFINITY, f64::min);
+            let hi = group
+                .iter()
+                .map(|x| x.1.b)
+                .fold(f64::NEG_INFINITY, f64::max);
+            intervals.clear();
+            intervals.extend(
+                self.history
+                    .of(key)
+                    .iter()
+                    .filter(|&&(x0, x1, _)| x1 > lo && x0 < hi),
+            );
+            let mut prev = detection_within(&intervals, lo, hi, &mut events);
+            let mut taken = 0;
+            for t in 1..=horizon {
+                let upto = group[taken..].iter().take_while(|x| x.0 <= t).count();
+                if upto == 0 {
+                    continue;
+                }
+                intervals.extend(
+                    group[taken..taken + upto]
+                        .iter()
+                        .map(|x| (x.1.a, x.1.b, x.1.p)),
+                );
+                taken += upto;
+                let now = detection_within(&intervals, lo, hi, &mut events);
+                by_step[t - 1] += w * (now - prev);
+                prev = now;
+            }
+        }
+        by_step
+    }
+
+    /// The background of a search: the history, and over it `extra`'s
+    /// looks (`extra[t − 1]` taken at step `t`).
+    fn background(&self, extra: &[Vec<Look>]) -> Background<'_> {
+        let mut buf = Vec::new();
+        let mut pieces = Vec::new();
+        for (t, step) in extra.iter().enumerate() {
+            for look in step {
+                self.pieces(look, t + 1, &mut pieces, &mut buf);
+            }
+        }
+        pieces.sort_by_key(|p| p.key);
+        let mut keys = Vec::new();
+        let mut merged = Profile::default();
+        merged.start.push(0);
+        let mut intervals: Vec<(f64, f64, f64)> = Vec::new();
+        let mut events = Vec::new();
+        for group in pieces.chunk_by(|x, y| x.key == y.key) {
+            let key = group[0].key;
+            intervals.clear();
+            intervals.extend(self.history.of(key as usize).iter().copied());
+            intervals.extend(group.iter().map(|p| (p.a, p.b, p.p)));
+            let lo = intervals.iter().map(|x| x.0).fold(f64::INFINITY, f64::min);
+            let hi = intervals
+                .iter()
+                .map(|x| x.1)
+                .fold(f64::NEG_INFINITY, f64::max);
+            let mut out = Vec::new();
+            detection_pieces(&intervals, lo, hi, &mut events, |a, b, d| {
+                out.push((a, b, d))
+            });
+            keys.push(key);
+            merged.push_key(out);
+        }
+        Background {
+            history: &self.history,
+            keys,
+            merged,
+        }
+    }
+
+    /// The gains of sensor `sensor`'s stops (see [`PathCover`]) on the
+    /// cells of `grid`'s motion around `start`, against the history and
+    /// `extra`'s looks (`extra[t − 1]` at step `t`); `grid`'s values become
+    /// each stop's gain alone.
+    pub fn path_cover(
+        &self,
+        sensor: usize,
+        start: Cell,
+        extra: &[Vec<Look>],
+        grid: &mut ValueGrid,
+    ) -> PathCover<'_> {
+        let s = self.est.scenario;
+        let ty = self.est.types[sensor];
+        let horizon = grid.horizon();
+        let extent = (grid.speed() * horizon) as i32;
+        let side = grid.side();
+        let background = self.background(extra);
+        let mut slots = vec![u32::MAX; horizon * side * side];
+        let mut start_of = vec![0u32];
+        let mut pieces: Vec<Piece> = Vec::new();
+        let mut alone: Vec<f64> = Vec::new();
+        let mut buf = Vec::new();
+        let mut one = Vec::new();
+        for t in 1..=horizon {
+            grid.fill_step(t, |dc, dr| {
+                let k = Cell {
+                    col: start.col + dc,
+                    row: start.row + dr,
+                };
+                if !s.on_lattice(k) {
+                    return None;
+                }
+                one.clear();
+                self.pieces(&s.look(ty, k), t, &mut one, &mut buf);
+                let mut total = 0.0;
+                for p in &one {
+                    let g = p.w * p.p * ((p.b - p.a) - background.detected(p.key, p.a, p.b));
+                    alone.push(g);
+                    total += g;
+                }
+                pieces.extend_from_slice(&one);
+                let index =
+                    (t - 1) * side * side + (dr + extent) as usize * side + (dc + extent) as usize;
+                slots[index] = (start_of.len() - 1) as u32;
+                start_of.push(pieces.len() as u32);
+                Some(total)
+            });
+        }
+        PathCover {
+            background,
+            extent,
+            side,
+            slots,
+            start_of,
+            pieces,
+            alone,
+        }
+    }
+}
+
+/// One sensor's path gains for [`crate::search::best_path_bounded`]: what
+/// each stop of a path adds to the first detections of the history and the
+/// other sensors' looks, on top of the path's earlier stops.
+pub struct PathCover<'f> {
+    background: Background<'f>,
+    extent: i32,
+    side: usize,
+    /// Per (step, offset) of the grid, its stop's index, `u32::MAX` where
+    /// none.
+    slots: Vec<u32>,
+    /// `pieces[start_of[i]..start_of[i + 1]]`: the `i`-th stop's pieces,
+    /// sorted by key.
+    start_of: Vec<u32>,
+    pieces: Vec<Piece>,
+    /// Aligned with `pieces`: each one's gain alone.
+    alone: Vec<f64>,
+}
+
+impl PathCover<'_> {
+    /// The stop of step `t` (1-based) at offset `(dc, dr)`.
+    fn stop(&self, t: usize, (dc, dr): (i32, i32)) -> std::ops::Range<usize> {
+        let index = (t - 1) * self.side * self.side
+            + (dr + self.extent) as usize * self.side
+            + (dc + self.extent) as usize;
+        let i = self.slots[index] as usize;
+        self.start_of[i] as usize..self.start_of[i + 1] as usize
+    }
+
+    /// The exact value of a whole path (offsets of steps 1, 2, …).
+    pub fn value(&self, stops: &[(i32, i32)]) -> f64 {
+        (1..=stops.len()).map(|t| self.gain(&stops[..t])).sum()
+    }
+}
+
+impl PathGain for PathCover<'_> {
+    fn gain(&self, stops: &[(i32, i32)]) -> f64 {
+        let t = stops.len();
+        let mine = self.stop(t, stops[t - 1]);
+        let earlier: Vec<&[Piece]> = (1..t)
+            .map(|u| &self.pieces[self.stop(u, stops[u - 1])])
+            .collect();
+        let mut cursors = vec![0usize; earlier.len()];
+        let mut over: Vec<(f64, f64, f64)> = Vec::new();
+        let mut events = Vec::new();
+        let mut total = 0.0;
+        for i in mine {
+            let x = self.pieces[i];
+            over.clear();
+            // Each earlier stop holds at most one piece per key; the pieces
+            // are sorted by key, so one cursor per stop walks them once.
+            for (e, c) in earlier.iter().zip(cursors.iter_mut()) {
+                while *c < e.len() && e[*c].key < x.key {
+                    *c += 1;
+                }
+                if let Some(q) = e
+                    .get(*c)
+                    .filter(|q| q.key == x.key && q.b > x.a && q.a < x.b)
+                {
+                    over.push((q.a, q.b, q.p));
+                }
+            }
+            if over.is_empty() {
+                total += self.alone[i];
+                continue;
+            }
+            // ∫ u·(1 − det_earlier) over the piece: its length less what is
+            // detected already, less what the earlier stops detect of the rest.
+            let mut left = (x.b - x.a) - self.background.detected(x.key, x.a, x.b);
+            detection_pieces(&over, x.a, x.b, &mut events, |a, b, d| {
+                left -= d * ((b - a) - self.background.detected(x.key, a, b));
+            });
+            total += x.w * x.p * left;
+        }
+        total
+    }
+}
