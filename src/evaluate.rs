@@ -18,9 +18,8 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::cancel::{CancelToken, Cancelled};
-use crate::coordination::{Fleet, path_moves, sensor_motion};
-use crate::estimator::Estimator;
-use crate::planner::{EstimatorKind, Id, PlanInput, PlanRequest, Planner};
+use crate::coordination::{Fleet, Objective, path_moves, sensor_motion};
+use crate::planner::{Chosen, EstimatorKind, Id, PlanInput, PlanRequest, Planner};
 use crate::scenario::{Cell, Integer, ValidationError};
 use crate::separation;
 
@@ -96,11 +95,16 @@ pub struct EvaluateResponse {
     pub horizon: usize,
     /// Estimator used.
     pub estimator: EstimatorKind,
+    /// Objective scored.
+    pub objective: Objective,
     /// Minimum separation counted, cells (0: none).
     pub min_separation: usize,
-    /// Expected distinct targets detected over steps 1..=T.
+    /// Expected distinct targets detected over steps 1..=T (for
+    /// `first_detections`: targets not yet detected that the paths detect
+    /// at least once).
     pub expected_detections: f64,
-    /// The same per step.
+    /// The same per step (for `first_detections`: detected for the first
+    /// time at that step).
     pub expected_by_step: Vec<f64>,
     /// The (step, pair of sensors) at which two paths are closer than
     /// `min_separation` allows.
@@ -263,7 +267,7 @@ pub struct Scores {
 /// An estimator prepared for one request's sensors and targets, scoring
 /// any paths of those sensors (many sets of them, for exhaustive checks).
 pub struct Evaluator<'p> {
-    est: Box<dyn Estimator + 'p>,
+    est: Chosen<'p>,
     planner: &'p Planner,
     plan: &'p PlanInput,
 }
@@ -285,43 +289,58 @@ impl<'p> Evaluator<'p> {
         })
     }
 
-    fn fleet<'a>(&'a self, cancel: &'a CancelToken) -> Fleet<'a> {
-        Fleet::new(
+    /// Runs `f` on the fleet of the request's sensors, maximising its
+    /// objective.
+    fn with_fleet<R>(&self, f: impl FnOnce(&Fleet) -> R) -> R {
+        let cancel = CancelToken::never();
+        let first = self.est.first_detections(self.plan.objective);
+        let mut fleet = Fleet::new(
             &self.planner.scenario,
-            self.est.as_ref(),
+            self.est.as_dyn(),
             &self.plan.starts,
             &self.plan.types,
             self.plan.horizon,
             self.plan.min_separation,
-            cancel,
-        )
+            &cancel,
+        );
+        if let Some(first) = &first {
+            fleet = fleet.with_first_detections(first);
+        }
+        f(&fleet)
     }
 
     /// The expected detections at steps 1..=T of `paths` (one per sensor,
     /// request order, each legal), counted in `order` (a permutation of
-    /// the sensors; it matters only to the paper estimator).
+    /// the sensors; it matters only to the paper estimator); for first
+    /// detections, the targets detected for the first time at each step.
     pub fn by_step(&self, paths: &[&[Cell]], order: &[usize]) -> Vec<f64> {
-        let cancel = CancelToken::never();
-        self.fleet(&cancel).by_step(paths, order)
+        self.with_fleet(|fleet| fleet.by_step(paths, order))
     }
 
     /// [`Evaluator::by_step`] and each sensor's marginal: its value against
-    /// every other path (exact), or the change in the total without it
+    /// every other path (exact; for first detections, the total less the
+    /// total without its path), or the change in the total without it
     /// (paper: its own value and the overlap reductions it causes below
     /// it).
     pub fn score(&self, paths: &[&[Cell]], order: &[usize]) -> Scores {
-        let cancel = CancelToken::never();
-        let fleet = self.fleet(&cancel);
-        let by_step = fleet.by_step(paths, order);
-        let marginals = (0..paths.len())
-            .map(|i| {
-                let rank = order.iter().position(|&q| q == i).unwrap_or(0);
-                (1..=self.plan.horizon)
-                    .map(|t| fleet.rank_change(paths, order, rank, paths[i][t - 1], t))
-                    .sum()
-            })
-            .collect();
-        Scores { by_step, marginals }
+        self.with_fleet(|fleet| {
+            let by_step = fleet.by_step(paths, order);
+            let marginals = (0..paths.len())
+                .map(|i| {
+                    if fleet.first.is_some() {
+                        let others: Vec<usize> =
+                            order.iter().copied().filter(|&q| q != i).collect();
+                        return by_step.iter().sum::<f64>()
+                            - fleet.by_step(paths, &others).iter().sum::<f64>();
+                    }
+                    let rank = order.iter().position(|&q| q == i).unwrap_or(0);
+                    (1..=self.plan.horizon)
+                        .map(|t| fleet.rank_change(paths, order, rank, paths[i][t - 1], t))
+                        .sum()
+                })
+                .collect();
+            Scores { by_step, marginals }
+        })
     }
 }
 
@@ -346,6 +365,7 @@ impl Planner {
             scenario: self.scenario.id.clone(),
             horizon: input.plan.horizon,
             estimator: input.plan.estimator,
+            objective: input.plan.objective,
             min_separation: d,
             expected_detections: by_step.iter().sum(),
             expected_by_step: by_step,

@@ -49,9 +49,10 @@ use std::sync::Arc;
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use crate::coordination::Coordination;
+use crate::coordination::{Coordination, Objective};
 use crate::geometry::Point;
 use crate::limits::{DEFAULT_HISTORY_STEPS, MAX_HISTORY_STEPS, MAX_TARGETS};
+use crate::planner::check_objective;
 use crate::planner::{
     EstimatorKind, Id, Observed, PlanRequest, Planner, PositionIn, SensorIn, TargetIn,
 };
@@ -75,6 +76,10 @@ pub struct SessionSettings {
     /// What the detections cover; `sensors` by default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub observed: Option<Observed>,
+    /// What the plans maximise; `detections` by default
+    /// (`first_detections` needs the `exact` estimator).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub objective: Option<Objective>,
     /// Minimum separation between sensors, cells (0..=16); the scenario's
     /// by default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -88,13 +93,18 @@ pub struct SessionSettings {
 }
 
 impl SessionSettings {
-    /// Checks the bounds no other check covers (`history_steps`; the
-    /// others are checked with every step's plan request) and gives the
-    /// history length.
+    /// Checks what can be checked before any step: `history_steps`, and an
+    /// `objective` the `estimator` cannot serve (the rest is checked with
+    /// every step's plan request). Gives the history length.
     ///
     /// # Errors
-    /// A [`ValidationError`] naming `history_steps`.
+    /// A [`ValidationError`] naming `history_steps` or `objective`.
     pub fn history_len(&self) -> Result<usize, ValidationError> {
+        check_objective(
+            "objective",
+            self.objective,
+            self.estimator.unwrap_or_default(),
+        )?;
         match &self.history_steps {
             None => Ok(DEFAULT_HISTORY_STEPS),
             Some(n) => n.check("history_steps", 0..=MAX_HISTORY_STEPS),
@@ -124,6 +134,9 @@ pub struct StepRequest {
     /// Coordination of this step; the session's by default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub coordination: Option<Coordination>,
+    /// Objective of this step; the session's by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub objective: Option<Objective>,
     /// Minimum separation of this step; the session's by default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(value_type = Option<u32>, minimum = 0)]
@@ -355,6 +368,7 @@ impl Session {
                 .or_else(|| self.settings.horizon.clone()),
             estimator: step.estimator.or(self.settings.estimator),
             coordination: step.coordination.or(self.settings.coordination),
+            objective: step.objective.or(self.settings.objective),
             observed: self.settings.observed,
             explain: step.explain,
             min_separation: step

@@ -426,6 +426,7 @@ impl Sim {
             estimator: settings.map(|p| p.estimator),
             coordination: settings.map(|p| p.coordination),
             observed: settings.map(|p| p.observed),
+            objective: None,
             explain: None,
             // Only when set: requests otherwise stay as they were, and the
             // server applies the scenario's.
@@ -487,6 +488,7 @@ impl Sim {
             estimator: settings.map(|p| p.estimator),
             coordination: settings.map(|p| p.coordination),
             observed: settings.map(|p| p.observed),
+            objective: None,
             min_separation: self.min_separation.map(Into::into),
             history_steps: Some(history.into()),
         }

@@ -92,6 +92,29 @@ pub fn marginal_bound(fleet: &Fleet, paths: &[&[Cell]], value: f64) -> Result<f6
     Ok(value + gains.iter().sum::<f64>())
 }
 
+/// [`marginal_bound`] for first detections: each sensor's bounded search
+/// against every path's looks at every step, its own included, gives an
+/// upper bound on what one more path of it could add (see
+/// [`Fleet::first_search`]); the same argument holds, the objective being
+/// a coverage of the targets over the whole horizon.
+///
+/// # Errors
+/// [`Cancelled`] once the fleet's token is cancelled.
+pub fn first_marginal_bound(
+    fleet: &Fleet,
+    paths: &[&[Cell]],
+    value: f64,
+) -> Result<f64, Cancelled> {
+    let all: Vec<usize> = (0..fleet.len()).collect();
+    let gains: Vec<f64> = (0..fleet.len())
+        .into_par_iter()
+        .with_min_len(crate::parallel::min_len())
+        .map(|i| fleet.first_search(i, paths, &all, Vec::new(), None).upper)
+        .collect();
+    fleet.cancel.check()?;
+    Ok(value + gains.iter().sum::<f64>())
+}
+
 /// A plan's certificate as it is worked out: the sum of the solo bests,
 /// and then either the relaxation's steps (when the estimator lists its
 /// pieces) or the marginal bound of each plan it is asked about.

@@ -5,10 +5,10 @@
 use rayon::prelude::*;
 
 use crate::cancel::CancelToken;
-use crate::estimator::Estimator;
+use crate::estimator::{Estimator, FirstDetections};
 use crate::geometry::{Rect, Region};
 use crate::scenario::{Cell, FovSpec, Look, Scenario};
-use crate::search::{BestPath, ValueGrid, best_path};
+use crate::search::{BestPath, ValueGrid, best_path, best_path_bounded};
 use crate::separation::mark_too_close;
 
 /// One sensor's plan.
@@ -42,6 +42,9 @@ pub struct Fleet<'a> {
     pub min_separation: usize,
     /// Checked before every step's values of every search.
     pub cancel: &'a CancelToken,
+    /// The intrusion objective, when the plan maximises first detections
+    /// instead of detections (see [`Fleet::with_first_detections`]).
+    pub first: Option<&'a FirstDetections<'a>>,
     /// Each sensor's motion (its speed, the free cells around it), built
     /// once and shared by every search it runs.
     motions: Vec<ValueGrid>,
@@ -71,8 +74,17 @@ impl<'a> Fleet<'a> {
             horizon,
             min_separation,
             cancel,
+            first: None,
             motions,
         }
+    }
+
+    /// The same fleet maximising first detections: every search is then
+    /// the bounded search of [`Fleet::first_search`], and totals count
+    /// each target once over the horizon.
+    pub fn with_first_detections(mut self, first: &'a FirstDetections<'a>) -> Self {
+        self.first = Some(first);
+        self
     }
 
     /// Number of sensors.
@@ -173,9 +185,13 @@ impl<'a> Fleet<'a> {
     }
 
     /// The expected detections of `paths` at each step 1..=T, counting the
-    /// sensors in `order` (each against the looks of those before it).
+    /// sensors in `order` (each against the looks of those before it); for
+    /// first detections, the targets each step detects for the first time.
     pub fn by_step(&self, paths: &[&[Cell]], order: &[usize]) -> Vec<f64> {
         let s = self.scenario;
+        if let Some(first) = self.first {
+            return first.by_step(&self.all_looks(paths, order));
+        }
         (1..=self.horizon)
             .map(|t| {
                 let mut above: Vec<Look> = Vec::with_capacity(order.len());
@@ -187,6 +203,92 @@ impl<'a> Fleet<'a> {
                 total
             })
             .collect()
+    }
+}
+
+/// What [`Fleet::first_search`] found for one sensor.
+#[derive(Debug, Clone)]
+pub struct FirstSearch {
+    /// The best path found, its value the exact gain in first detections.
+    pub plan: SensorPlan,
+    /// No path of the sensor (separation ignored) gains more than this.
+    pub upper: f64,
+    /// The exact gain and violations of the `current` path asked about.
+    pub current: Option<(f64, u32)>,
+}
+
+/// Gains a first-detections search evaluates at most: every path of a
+/// speed-1 sensor up to T = 4 (9 + 9² + 9³ + 9⁴ = 7,380 prefixes) fits,
+/// so those searches are exact; beyond, the search keeps the best path
+/// found and its bound.
+pub const FIRST_SEARCH_BUDGET: usize = 20_000;
+
+impl Fleet<'_> {
+    /// Every look of `sensors` on `paths`, per step 1..=T.
+    pub fn all_looks(&self, paths: &[&[Cell]], sensors: &[usize]) -> Vec<Vec<Look>> {
+        (1..=self.horizon)
+            .map(|t| {
+                sensors
+                    .iter()
+                    .map(|&q| self.scenario.look(self.types[q], paths[q][t - 1]))
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Sensor `i`'s best path for first detections against the looks of
+    /// `sensors` on `paths` (at every step: a target another sensor
+    /// detects at step 1 is not there to detect at step 3), around
+    /// `avoid`'s paths; with `current`, that path's exact gain too.
+    ///
+    /// # Panics
+    /// On a fleet without [`Fleet::with_first_detections`].
+    pub fn first_search(
+        &self,
+        i: usize,
+        paths: &[&[Cell]],
+        sensors: &[usize],
+        avoid: Vec<&[Cell]>,
+        current: Option<&[Cell]>,
+    ) -> FirstSearch {
+        let first = self.first.expect("a fleet maximising first detections");
+        let mut grid = self.motion(i);
+        let cover = first.path_cover(
+            i,
+            self.starts[i],
+            &self.all_looks(paths, sensors),
+            &mut grid,
+        );
+        mark_too_close(&mut grid, self.starts[i], self.min_separation, avoid);
+        let found = best_path_bounded(&grid, &cover, FIRST_SEARCH_BUDGET);
+        let current = current.and_then(|path| {
+            let moves = path_moves(self.starts[i], path);
+            let violations = grid.path_violations(&moves)?;
+            let offsets: Vec<(i32, i32)> = path
+                .iter()
+                .map(|c| (c.col - self.starts[i].col, c.row - self.starts[i].row))
+                .collect();
+            Some((cover.value(&offsets), violations))
+        });
+        let path = found
+            .best
+            .offsets()
+            .into_iter()
+            .map(|(dc, dr)| Cell {
+                col: self.starts[i].col + dc,
+                row: self.starts[i].row + dr,
+            })
+            .collect();
+        FirstSearch {
+            plan: SensorPlan {
+                path,
+                value: found.best.value,
+                violations: found.best.violations,
+                grid,
+            },
+            upper: found.upper,
+            current,
+        }
     }
 }
 

@@ -18,6 +18,17 @@
 //! Every plan with an order-independent (exact) estimator carries its
 //! certificate: an upper bound on the best joint plan ([`certificate`]).
 //!
+//! With [`Objective::FirstDetections`] (a fleet made with
+//! [`Fleet::with_first_detections`]) every search above is the bounded
+//! search of [`Fleet::first_search`]: a sensor's value for a path is its
+//! exact marginal, the first detections it adds to those of the paths it
+//! plans against over the whole horizon (a target another sensor detects
+//! at step 1 is not there for it at step 3). The priority pass, the repair
+//! rounds and the best-response rounds run as above on those marginals;
+//! `Joint` runs as `Iterated`, and the certificate is the smaller of the
+//! solo searches' bounds summed and the marginal bound
+//! ([`certificate::first_marginal_bound`]).
+//!
 //! The total is `Σ_t Σ_p value(p, cell_p(t), t, looks of the sensors ranked
 //! above p at t)`: for the exact estimator the expected number of
 //! (target, step) pairs detected by at least one sensor, whatever the order
@@ -90,6 +101,20 @@ pub enum Coordination {
     Joint,
 }
 
+/// What a plan maximises.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Objective {
+    /// The paper's J: expected detections summed over the steps (a target
+    /// seen at two steps counts twice).
+    #[default]
+    Detections,
+    /// Expected targets not yet detected (not reported, unseen in the
+    /// history) that the plan detects at least once over steps 1..=T: the
+    /// intrusion objective. Needs the `exact` estimator.
+    FirstDetections,
+}
+
 /// Plans of every sensor, in request order, with their ranks.
 #[derive(Debug, Clone)]
 pub struct Coordinated {
@@ -135,12 +160,24 @@ pub fn coordinate(
         ..
     } = *fleet;
     let n = starts.len();
-    // Every sensor alone.
-    let mut plans: Vec<SensorPlan> = (0..n)
-        .into_par_iter()
-        .with_min_len(crate::parallel::min_len())
-        .map(|i| fleet.plan_one(i, &mut |t, g| est.fill(i, starts[i], t, &[], g), Vec::new()))
-        .collect();
+    // Every sensor alone (for first detections, with the upper bound of
+    // its search, which the certificate sums).
+    let (mut plans, solo_upper): (Vec<SensorPlan>, f64) = if fleet.first.is_some() {
+        let found: Vec<_> = (0..n)
+            .into_par_iter()
+            .with_min_len(crate::parallel::min_len())
+            .map(|i| fleet.first_search(i, &[], &[], Vec::new(), None))
+            .collect();
+        let upper = found.iter().map(|f| f.upper).sum();
+        (found.into_iter().map(|f| f.plan).collect(), upper)
+    } else {
+        let plans = (0..n)
+            .into_par_iter()
+            .with_min_len(crate::parallel::min_len())
+            .map(|i| fleet.plan_one(i, &mut |t, g| est.fill(i, starts[i], t, &[], g), Vec::new()))
+            .collect();
+        (plans, f64::INFINITY)
+    };
     cancel.check()?;
     let solo: Vec<(f64, Vec<Cell>)> = plans.iter().map(|p| (p.value, p.path.clone())).collect();
     let mut order: Vec<usize> = (0..n).collect();
@@ -148,7 +185,8 @@ pub fn coordinate(
     order.sort_by(|&a, &b| plans[b].value.total_cmp(&plans[a].value));
     // Each sensor's lone values, which the later passes start from; an
     // exact plan's certificate starts from them too.
-    let alone: Vec<ValueGrid> = if mode != Coordination::None || d > 0 || est.order_independent() {
+    let grids_wanted = mode != Coordination::None || d > 0 || est.order_independent();
+    let alone: Vec<ValueGrid> = if fleet.first.is_none() && grids_wanted {
         plans.iter().map(|p| p.grid.clone()).collect()
     } else {
         Vec::new()
@@ -174,7 +212,16 @@ pub fn coordinate(
     let mut by_step = fleet.by_step(&path_slices(&plans), &order);
     cancel.check()?;
     let mut report = None;
-    let bound = if est.order_independent() {
+    let bound = if fleet.first.is_some() {
+        let value: f64 = by_step.iter().sum();
+        Some(Bound::new(
+            value,
+            [
+                solo_upper,
+                certificate::first_marginal_bound(fleet, &path_slices(&plans), value)?,
+            ],
+        ))
+    } else if est.order_independent() {
         let mut value: f64 = by_step.iter().sum();
         let mut certifier = Certifier::new(fleet, solo, &alone);
         if mode == Coordination::Joint {

@@ -54,6 +54,13 @@ impl Ranking<'_, '_> {
             self.paths(plans, above.iter().copied())
         };
         let avoid = avoid.iter().map(Vec::as_slice).collect();
+        if self.fleet.first.is_some() {
+            let against = if self.independent { &[][..] } else { above };
+            return self
+                .fleet
+                .first_search(i, &path_slices(plans), against, avoid, None)
+                .plan;
+        }
         if self.independent {
             let mut grid = self.alone[i].clone();
             mark_too_close(&mut grid, starts[i], d, avoid);

@@ -63,36 +63,49 @@ pub fn best_responses(
                     .map(|j| plans[j].path.as_slice())
                     .collect()
             };
-            let grid_plan = if est.order_independent() {
+            let (grid_plan, current) = if fleet.first.is_some() {
                 let others: Vec<usize> = order.iter().copied().filter(|&j| j != i).collect();
-                let looks = fleet.looks_by_step(&path_slices(plans), &others, i);
-                fleet.plan_one(
+                let found = fleet.first_search(
                     i,
-                    &mut |t, g| est.fill(i, starts[i], t, &looks[t - 1], g),
+                    &path_slices(plans),
+                    &others,
                     avoid,
-                )
+                    Some(&plans[i].path),
+                );
+                (found.plan, found.current)
             } else {
-                let current = path_slices(plans);
-                fleet.plan_one(
-                    i,
-                    &mut |t, g| {
-                        g.fill_step(t, |dc, dr| {
-                            let k = Cell {
-                                col: starts[i].col + dc,
-                                row: starts[i].row + dr,
-                            };
-                            Some(fleet.rank_change(&current, order, rank, k, t))
-                        });
-                    },
-                    avoid,
-                )
+                let grid_plan = if est.order_independent() {
+                    let others: Vec<usize> = order.iter().copied().filter(|&j| j != i).collect();
+                    let looks = fleet.looks_by_step(&path_slices(plans), &others, i);
+                    fleet.plan_one(
+                        i,
+                        &mut |t, g| est.fill(i, starts[i], t, &looks[t - 1], g),
+                        avoid,
+                    )
+                } else {
+                    let current = path_slices(plans);
+                    fleet.plan_one(
+                        i,
+                        &mut |t, g| {
+                            g.fill_step(t, |dc, dr| {
+                                let k = Cell {
+                                    col: starts[i].col + dc,
+                                    row: starts[i].row + dr,
+                                };
+                                Some(fleet.rank_change(&current, order, rank, k, t))
+                            });
+                        },
+                        avoid,
+                    )
+                };
+                let current = grid_plan
+                    .grid
+                    .path_score(&path_moves(starts[i], &plans[i].path));
+                (grid_plan, current)
             };
             fleet.cancel.check()?;
-            let current = path_moves(starts[i], &plans[i].path);
-            let (current_value, current_violations) = grid_plan
-                .grid
-                .path_score(&current)
-                .unwrap_or((f64::NEG_INFINITY, u32::MAX));
+            let (current_value, current_violations) =
+                current.unwrap_or((f64::NEG_INFINITY, u32::MAX));
             let tol = 1e-9 * current_value.abs().max(1.0);
             if grid_plan.violations < current_violations
                 || (grid_plan.violations == current_violations

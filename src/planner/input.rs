@@ -5,7 +5,7 @@
 use std::collections::HashSet;
 
 use super::wire::*;
-use crate::coordination::{Coordination, JointSettings};
+use crate::coordination::{Coordination, JointSettings, Objective};
 use crate::estimator::Target;
 use crate::geometry::Point;
 use crate::limits::{
@@ -27,6 +27,7 @@ pub struct PlanInput {
     pub(crate) horizon: usize,
     pub(crate) estimator: EstimatorKind,
     pub(crate) coordination: Coordination,
+    pub(crate) objective: Objective,
     pub(crate) observed: Observed,
     pub(crate) explain: bool,
     pub(crate) min_separation: usize,
@@ -39,6 +40,24 @@ fn finite(field: impl Fn() -> String, v: f64) -> Result<f64, ValidationError> {
     } else {
         Err(ValidationError::new(field(), "must be a finite number"))
     }
+}
+
+/// The objective asked for (`detections` by default), refused for the
+/// paper estimator when it is `first_detections`: its values are per step
+/// and per cell, with no notion of a target detected before.
+pub(crate) fn check_objective(
+    field: &str,
+    objective: Option<Objective>,
+    estimator: EstimatorKind,
+) -> Result<Objective, ValidationError> {
+    let objective = objective.unwrap_or_default();
+    if objective == Objective::FirstDetections && estimator == EstimatorKind::Paper {
+        return Err(ValidationError::new(
+            field,
+            "first_detections needs the exact estimator (the paper estimator has no notion of a target detected before)",
+        ));
+    }
+    Ok(objective)
 }
 
 impl PlanInput {
@@ -188,6 +207,8 @@ impl PlanInput {
             let ms = b.check("budget_ms", 1..=MAX_BUDGET_MS as usize)?;
             joint.budget = std::time::Duration::from_millis(ms as u64);
         }
+        let estimator = req.estimator.unwrap_or_default();
+        let objective = check_objective("objective", req.objective, estimator)?;
         Ok(PlanInput {
             min_separation,
             ids,
@@ -196,8 +217,9 @@ impl PlanInput {
             targets,
             history: past,
             horizon,
-            estimator: req.estimator.unwrap_or_default(),
+            estimator,
             coordination: req.coordination.unwrap_or_default(),
+            objective,
             observed: req.observed.unwrap_or_default(),
             explain: req.explain.unwrap_or(false),
             joint,

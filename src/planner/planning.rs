@@ -8,9 +8,10 @@ use std::time::Instant;
 use super::input::PlanInput;
 use super::wire::*;
 use crate::cancel::{CancelToken, Cancelled, Progress};
-use crate::coordination::{Fleet, coordinate};
+use crate::coordination::{Fleet, Objective, coordinate};
 use crate::estimator::{
-    ElementaryGrid, Estimator, ExactEstimator, PaperEstimator, Precomputed, Situation, SourceRays,
+    ElementaryGrid, Estimator, ExactEstimator, FirstDetections, PaperEstimator, Precomputed,
+    Situation, SourceRays,
 };
 use crate::scenario::{Cell, Look, Scenario, ValidationError};
 use crate::stats::Stats;
@@ -158,15 +159,19 @@ impl Planner {
         let s = &self.scenario;
         let est = self.estimator(input, cancel)?;
         cancel.check()?;
-        let fleet = Fleet::new(
+        let first = est.first_detections(input.objective);
+        let mut fleet = Fleet::new(
             s,
-            est.as_ref(),
+            est.as_dyn(),
             &input.starts,
             &input.types,
             input.horizon,
             input.min_separation,
             cancel,
         );
+        if let Some(first) = &first {
+            fleet = fleet.with_first_detections(first);
+        }
         let result = coordinate(&fleet, input.coordination, input.joint, started)?;
         let cell_out = |c: Cell| {
             let p = s.centre(c);
@@ -202,6 +207,7 @@ impl Planner {
             horizon: input.horizon,
             estimator: input.estimator,
             coordination: input.coordination,
+            objective: input.objective,
             min_separation: input.min_separation,
             separation_violations: result.violations.pairs,
             plans,
@@ -222,10 +228,10 @@ impl Planner {
         &self,
         input: &PlanInput,
         cancel: &CancelToken,
-    ) -> Result<Box<dyn Estimator + '_>, Cancelled> {
+    ) -> Result<Chosen<'_>, Cancelled> {
         let s = &self.scenario;
         Ok(match input.estimator {
-            EstimatorKind::Paper => Box::new(PaperEstimator::new(
+            EstimatorKind::Paper => Chosen::Paper(PaperEstimator::new(
                 s,
                 &self.stats,
                 &input.starts,
@@ -252,7 +258,7 @@ impl Planner {
                 );
                 cancel.check()?;
                 est.prepare();
-                Box::new(est)
+                Chosen::Exact(est)
             }
         })
     }
@@ -282,6 +288,31 @@ impl Planner {
                     .collect()
             }))
             .collect()
+    }
+}
+
+/// The estimator a plan asked for.
+pub(crate) enum Chosen<'p> {
+    Paper(PaperEstimator<'p>),
+    Exact(ExactEstimator<'p>),
+}
+
+impl Chosen<'_> {
+    /// As an [`Estimator`].
+    pub(crate) fn as_dyn(&self) -> &dyn Estimator {
+        match self {
+            Chosen::Paper(est) => est,
+            Chosen::Exact(est) => est,
+        }
+    }
+
+    /// The intrusion objective over the exact estimator, when `objective`
+    /// asks for it (a validated input never asks it of the paper's).
+    pub(crate) fn first_detections(&self, objective: Objective) -> Option<FirstDetections<'_>> {
+        match (objective, self) {
+            (Objective::FirstDetections, Chosen::Exact(est)) => Some(FirstDetections::new(est)),
+            _ => None,
+        }
     }
 }
 

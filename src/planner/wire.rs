@@ -5,7 +5,7 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
-use crate::coordination::{Bound, Coordination, JointReport};
+use crate::coordination::{Bound, Coordination, JointReport, Objective};
 use crate::scenario::Integer;
 
 /// Which estimator of `n̂(k,t)` to use.
@@ -179,6 +179,11 @@ pub struct PlanRequest {
     /// What the reported targets cover; `sensors` by default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub observed: Option<Observed>,
+    /// What the plan maximises; `detections` (the paper's J) by default.
+    /// `first_detections` (the `exact` estimator only) counts each target
+    /// not yet detected once, at the first step the plan detects it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub objective: Option<Objective>,
     /// Include the search values in the response.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub explain: Option<bool>,
@@ -235,7 +240,8 @@ pub struct PlanOut {
     pub start: CellOut,
     /// Cells at steps 1..=T.
     pub path: Vec<CellOut>,
-    /// The value its final search maximised.
+    /// The value its final search maximised (for `first_detections`, the
+    /// first detections its path adds to those it planned against).
     pub expected_detections: f64,
     /// The (step, other sensor) pairs at which its path is closer to
     /// another sensor's than `min_separation` allows.
@@ -256,6 +262,8 @@ pub struct PlanResponse {
     pub estimator: EstimatorKind,
     /// Coordination used.
     pub coordination: Coordination,
+    /// Objective maximised.
+    pub objective: Objective,
     /// Minimum separation kept, cells (0: none).
     pub min_separation: usize,
     /// The (step, pair of sensors) at which two paths are closer than
@@ -264,9 +272,12 @@ pub struct PlanResponse {
     pub separation_violations: u32,
     /// Plans in request order.
     pub plans: Vec<PlanOut>,
-    /// Expected distinct targets detected over steps 1..=T.
+    /// Expected distinct targets detected over steps 1..=T, summed over the
+    /// steps (`detections`), or expected targets not yet detected that the
+    /// plan detects at least once (`first_detections`).
     pub expected_detections: f64,
-    /// The same per step.
+    /// The same per step (for `first_detections`: the targets detected for
+    /// the first time at that step).
     pub expected_by_step: Vec<f64>,
     /// With the `exact` estimator: an upper bound on what the best joint
     /// plan could expect, and how far this plan may be from it (see the

@@ -10,6 +10,7 @@ mod evaluate;
 mod fleet;
 mod fuzz;
 mod helpers;
+mod intrusion;
 mod jobs;
 mod openapi;
 mod ops;

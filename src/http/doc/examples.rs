@@ -190,6 +190,7 @@ pub fn plan_response() -> Value {
         "horizon": 3,
         "estimator": "exact",
         "coordination": "priority",
+        "objective": "detections",
         "min_separation": 0,
         "separation_violations": 0,
         "plans": [
@@ -250,6 +251,7 @@ pub fn evaluate_response() -> Value {
         "scenario": "paper-v10",
         "horizon": 3,
         "estimator": "exact",
+        "objective": "detections",
         "min_separation": 0,
         "expected_detections": 19.0996,
         "expected_by_step": [4.808, 6.538, 7.7535],
@@ -300,6 +302,7 @@ pub fn step_response() -> Value {
         "horizon": 3,
         "estimator": "exact",
         "coordination": "priority",
+        "objective": "detections",
         "min_separation": 0,
         "separation_violations": 0,
         "plans": [

@@ -3,7 +3,7 @@
 
 use utoipa::ToSchema;
 
-use crate::coordination::Coordination;
+use crate::coordination::{Coordination, Objective};
 use crate::evaluate::SensorPathIn;
 use crate::planner::{EstimatorKind, Observed, PositionIn, SensorIn, TargetIn};
 use crate::scenario::{Integer, ScenarioSpec};
@@ -38,6 +38,11 @@ macro_rules! plan_request_with {
             pub coordination: Option<Coordination>,
             /// What the reported targets cover; `sensors` by default.
             pub observed: Option<Observed>,
+            /// What the plan maximises; `detections` (the paper's J) by
+            /// default. `first_detections` (the `exact` estimator only)
+            /// counts each target not yet detected once, at the first step
+            /// the plan detects it.
+            pub objective: Option<Objective>,
             /// Include the search values in the response.
             pub explain: Option<bool>,
             /// Minimum separation between sensors at every step, cells
