@@ -27,7 +27,7 @@ use vigil::scenario::{Cell, Scenario};
 use vigil::session::{SessionSettings, StepRequest};
 use vigil::world::World;
 
-use crate::metrics::StepCount;
+use crate::metrics::{Entries, StepCount};
 use crate::policy::{Policy, keep_apart, legal_moves, local_force_move, random_move};
 
 /// A plan's certificate, checked against the planner's contract: with the
@@ -208,10 +208,13 @@ pub struct Sim {
     pub step: usize,
     /// Last step each target was seen by some sensor.
     last_seen: HashMap<u64, usize>,
-    /// Targets first seen in the zone at or after `window_start`.
-    entered: HashSet<u64>,
-    /// Of those, the ones detected at least once.
-    detected: HashSet<u64>,
+    /// Targets that entered the zone after `window_start` (not in it then,
+    /// in it at the end of a later step), each with its entry step: the
+    /// first step at whose end it was in the zone.
+    entered: HashMap<u64, usize>,
+    /// Of those, the ones detected at least once, each with the step at
+    /// which some sensor first detected it.
+    detected: HashMap<u64, usize>,
     in_zone_before: HashSet<u64>,
     window_start: Option<usize>,
     /// Each sensor's cell after every step, for pictures.
@@ -283,31 +286,65 @@ impl Sim {
             history_len,
             step: 0,
             last_seen: HashMap::new(),
-            entered: HashSet::new(),
-            detected: HashSet::new(),
+            entered: HashMap::new(),
+            detected: HashMap::new(),
             in_zone_before: HashSet::new(),
             window_start: None,
             min_separation: None,
         }
     }
 
-    /// Starts counting `detected_once` from now.
+    /// Starts counting the targets that enter the zone from now
+    /// ([`Sim::entries`]); those in it now are never counted.
     pub fn start_window(&mut self) {
         self.window_start = Some(self.step);
         self.in_zone_before = self.world.in_zone(&self.scenario).map(|t| t.id).collect();
     }
 
     /// The fraction of the targets that entered since [`Sim::start_window`]
-    /// that were detected at least once.
+    /// that were detected at least once ([`Entries::detected_once`]).
     pub fn detected_once(&self) -> f64 {
-        if self.entered.is_empty() {
-            return 0.0;
+        self.entries().detected_once()
+    }
+
+    /// Of the targets that entered since [`Sim::start_window`] and were
+    /// detected, the mean steps from entry to first detection
+    /// ([`Entries::delay`]).
+    pub fn delay(&self) -> Option<f64> {
+        self.entries().delay()
+    }
+
+    /// Of the targets that entered since [`Sim::start_window`] and have
+    /// left the zone, the fraction never detected ([`Entries::missed`]).
+    pub fn missed(&self) -> Option<f64> {
+        self.entries().missed()
+    }
+
+    /// The counts of the targets that entered the zone since
+    /// [`Sim::start_window`]: how many, how many were detected and after
+    /// how many steps, how many have left and how many of those were never
+    /// detected. A target is counted from the end of the first step at
+    /// which it is in the zone (its entry step); one that has entered is
+    /// gone once it is out of the zone (a straight path leaves the zone
+    /// once), so those not in the zone now are the ones that left.
+    pub fn entries(&self) -> Entries {
+        let in_zone: HashSet<u64> = self.now.iter().map(|&(id, _, _)| id).collect();
+        let mut e = Entries {
+            entered: self.entered.len(),
+            detected: self.detected.len(),
+            ..Entries::default()
+        };
+        for (id, &entry) in &self.entered {
+            let first = self.detected.get(id);
+            if let Some(&first) = first {
+                e.delay_steps += first - entry;
+            }
+            if !in_zone.contains(id) {
+                e.left += 1;
+                e.left_undetected += usize::from(first.is_none());
+            }
         }
-        self.entered
-            .iter()
-            .filter(|id| self.detected.contains(id))
-            .count() as f64
-            / self.entered.len() as f64
+        e
     }
 
     /// The targets in the zone now, each with its id, position and how many
@@ -623,12 +660,104 @@ impl Sim {
                 }
             }
             if self.window_start.is_some() && !self.in_zone_before.contains(&id) {
-                self.entered.insert(id);
+                // The first step each is seen in the zone, and detected,
+                // is the one kept.
+                self.entered.entry(id).or_insert(self.step);
                 if n > 0 {
-                    self.detected.insert(id);
+                    self.detected.entry(id).or_insert(self.step);
                 }
             }
         }
         count
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use vigil::scenario::paper_spec;
+    use vigil::world::SimTarget;
+
+    use super::*;
+
+    /// A target at `(x, y)` flying `(vx, vy)` per step.
+    fn target(s: &Scenario, id: u64, (x, y): (f64, f64), (vx, vy): (f64, f64)) -> SimTarget {
+        let pos = Point::new(x, y);
+        SimTarget {
+            id,
+            pos,
+            vel: Point::new(vx, vy),
+            entered: s.in_zone(pos),
+            source: 0,
+        }
+    }
+
+    /// The bookkeeping behind `detected_once`, `delay` and `missed` on a
+    /// world made by hand: `paper-v10`'s zone (300 m square, 10 m cells, a
+    /// 60 m square field of view) with its sources silenced, one sensor
+    /// held at cell (5, 15), which sees x ∈ [25, 85], y ∈ [125, 185], and
+    /// four targets whose steps in and out of the zone and the view are
+    /// worked out below.
+    #[test]
+    fn entries_follow_entry_first_detection_and_departure() {
+        let mut spec = paper_spec(10.0);
+        for src in &mut spec.sources {
+            src.rate = 0.0;
+        }
+        let s = Scenario::new(spec).expect("valid");
+        let mut sim = Sim::new(s.clone(), 1, Start::Grid, 1, 0);
+        sim.sensors = vec![Cell { col: 5, row: 15 }];
+        sim.world.targets = vec![
+            // In at step 3 (x = 8), in view at step 5 (x = 28), out at
+            // step 33 (x = 308).
+            target(&s, 0, (-22.0, 150.0), (10.0, 0.0)),
+            // In at step 1 (y = 50) far east of the view, out at step 4.
+            target(&s, 1, (290.0, -50.0), (0.0, 100.0)),
+            // In at step 1 (x = 0.5), in view at step 14 (x = 26.5), still
+            // in the zone at the end (x = 78.5).
+            target(&s, 2, (-1.5, 160.0), (2.0, 0.0)),
+            // In the zone, and in view, when the window starts: never
+            // counted, though detected at every step.
+            target(&s, 3, (40.0, 150.0), (0.5, 0.0)),
+        ];
+        sim.start_window();
+        let mut after = vec![Entries::default()];
+        for _ in 0..40 {
+            let stay = sim.sensors.clone();
+            let count = sim.advance(stay);
+            assert!(count.detected >= 1, "step {}: the held target", sim.step);
+            after.push(sim.entries());
+        }
+        let e = |entered, detected, delay_steps, left, left_undetected| Entries {
+            entered,
+            detected,
+            delay_steps,
+            left,
+            left_undetected,
+        };
+        assert_eq!(after[1], e(2, 0, 0, 0, 0));
+        assert_eq!(after[2], e(2, 0, 0, 0, 0));
+        assert_eq!(after[3], e(3, 0, 0, 0, 0));
+        // The second target left unseen: missed, and no delay yet.
+        assert_eq!(after[4], e(3, 0, 0, 1, 1));
+        assert_eq!((after[4].delay(), after[4].missed()), (None, Some(1.0)));
+        // The first, in at step 3, first detected at step 5: delay 2.
+        assert_eq!(after[5], e(3, 1, 2, 1, 1));
+        assert_eq!(after[5].delay(), Some(2.0));
+        assert_eq!(after[13], e(3, 1, 2, 1, 1));
+        assert_eq!(after[14], e(3, 2, 15, 1, 1));
+        assert_eq!(after[32], e(3, 2, 15, 1, 1));
+        // The first leaves, detected: not missed.
+        assert_eq!(after[33], e(3, 2, 15, 2, 1));
+        assert_eq!(after[40], e(3, 2, 15, 2, 1));
+        assert_eq!(sim.detected_once(), 2.0 / 3.0);
+        assert_eq!(sim.delay(), Some(7.5));
+        assert_eq!(sim.missed(), Some(0.5));
+        // `missed` counts only the targets that left, so it may exceed the
+        // fraction never detected (the third target, detected and still in
+        // the zone, counts only there); the counts cannot: every missed
+        // target is an undetected one.
+        assert!(sim.missed() > Some(1.0 - sim.detected_once()));
+        let last = after[40];
+        assert!(last.left_undetected <= last.entered - last.detected);
     }
 }

@@ -177,7 +177,7 @@ pub async fn run_one(
     if let Some(id) = &session {
         client.close_session(id).await?;
     }
-    let metrics = acc.finish(sim.detected_once());
+    let metrics = acc.finish(sim.entries());
     Ok((metrics, keep.then_some(sim)))
 }
 

@@ -456,6 +456,11 @@ struct MetricsOut {
     ad_mean: f64,
     af_mean: f64,
     once: f64,
+    /// The run's `delay` and `missed` so far ([`Sim::entries`]): `delay`
+    /// is `None` until a counted target has been detected, `missed` until
+    /// one has left the zone.
+    delay: Option<f64>,
+    missed: Option<f64>,
     calibration: Option<f64>,
     plan_ms: Option<f64>,
     plan_ms_mean: Option<f64>,
@@ -480,6 +485,8 @@ struct Series {
     ad: Vec<f64>,
     af: Vec<f64>,
     once: Vec<f64>,
+    delay: Vec<Option<f64>>,
+    missed: Vec<Option<f64>>,
     calibration: Vec<Option<f64>>,
     plan_ms: Vec<Option<f64>>,
     gap: Vec<Option<f64>>,
@@ -700,10 +707,13 @@ async fn drive(shared: Arc<Shared>, client: Client, opts: LiveOptions) -> Result
             run.gaps += 1;
         }
         let calibration = (run.predicted > 0.0).then(|| run.realized / run.predicted);
-        let once = sim.detected_once();
+        let entries = sim.entries();
+        let (once, delay, missed) = (entries.detected_once(), entries.delay(), entries.missed());
         series.ad.push(count.detected as f64);
         series.af.push(af.unwrap_or(0.0));
         series.once.push(once);
+        series.delay.push(delay);
+        series.missed.push(missed);
         series.calibration.push(calibration);
         series.plan_ms.push(plan_ms);
         series.gap.push(gap);
@@ -718,6 +728,8 @@ async fn drive(shared: Arc<Shared>, client: Client, opts: LiveOptions) -> Result
                 0.0
             },
             once,
+            delay,
+            missed,
             calibration,
             plan_ms,
             plan_ms_mean: (run.plans > 0).then(|| run.plan_ms / run.plans as f64),

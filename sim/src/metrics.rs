@@ -20,6 +20,54 @@ pub struct StepCount {
     pub cells: usize,
 }
 
+/// What the driver counted of the targets that entered the zone during the
+/// measured window ([`crate::driver::Sim::entries`]): the counts behind
+/// `detected_once`, `delay` and `missed`.
+///
+/// A target is counted when it is in the zone at the end of some measured
+/// step and was not in it when the window started; its entry step is the
+/// first such step, the one during which it crossed into the zone. A
+/// target that crosses a corner within one step is never in the zone at a
+/// step, could not have been detected, and is not counted.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Entries {
+    /// Targets that entered the zone during the window.
+    pub entered: usize,
+    /// Of those, the ones detected at least once.
+    pub detected: usize,
+    /// Σ over the detected of (first detection step − entry step).
+    pub delay_steps: usize,
+    /// Of the entered, the ones no longer in the zone: they left it.
+    pub left: usize,
+    /// Of those that left, the ones never detected.
+    pub left_undetected: usize,
+}
+
+impl Entries {
+    /// The fraction of the entered targets detected at least once; 0 when
+    /// none entered.
+    pub fn detected_once(&self) -> f64 {
+        if self.entered == 0 {
+            return 0.0;
+        }
+        self.detected as f64 / self.entered as f64
+    }
+
+    /// The mean over the detected targets of the steps from entry to first
+    /// detection (0: detected on the step it entered); `None` when none was
+    /// detected, as a delay of 0 would read as instant detection.
+    pub fn delay(&self) -> Option<f64> {
+        (self.detected > 0).then(|| self.delay_steps as f64 / self.detected as f64)
+    }
+
+    /// The fraction of the targets that left the zone that were never
+    /// detected; `None` when none has left. Targets still in the zone are
+    /// in neither count: they may yet be detected.
+    pub fn missed(&self) -> Option<f64> {
+        (self.left > 0).then(|| self.left_undetected as f64 / self.left as f64)
+    }
+}
+
 /// Accumulates the steps of one run.
 #[derive(Debug, Clone, Default)]
 pub struct RunAccumulator {
@@ -107,8 +155,9 @@ impl RunAccumulator {
         self.plan_ms.push(ms);
     }
 
-    /// The run's averages. `detected_once` is computed by the driver.
-    pub fn finish(mut self, detected_once: f64) -> Metrics {
+    /// The run's averages. `detected_once`, `delay` and `missed` come from
+    /// the driver's count of the targets that entered during the window.
+    pub fn finish(mut self, entries: Entries) -> Metrics {
         let n = self.steps.max(1) as f64;
         let planner = !self.plan_ms.is_empty();
         self.plan_ms.sort_by(f64::total_cmp);
@@ -132,7 +181,9 @@ impl RunAccumulator {
             d3s: self.d[2] / n,
             d4s: self.d4 / n,
             cells: self.cells / n,
-            detected_once,
+            detected_once: entries.detected_once(),
+            delay: entries.delay(),
+            missed: entries.missed(),
             calibration: (planner && self.predicted_next > 0.0)
                 .then(|| self.realized_next / self.predicted_next),
             plan_ms_p50: planner.then(|| pct(&self.plan_ms, 0.5)),
@@ -174,6 +225,20 @@ pub struct Metrics {
     /// Fraction of the targets that entered during the measured window that
     /// were detected at least once.
     pub detected_once: f64,
+    /// Of the targets counted by `detected_once` that were detected, the
+    /// mean number of steps from entry to first detection: the step at
+    /// which some sensor first detected the target minus its entry step,
+    /// the first step at whose end it was in the zone (the step during
+    /// which it crossed into it); 0 when detected on the step it entered.
+    /// `None` (JSON `null`) when no such target was detected; over seeds,
+    /// the mean over the runs where it is defined.
+    pub delay: Option<f64>,
+    /// Of the targets counted by `detected_once` that have left the zone
+    /// by the end of the run, the fraction never detected. Targets still
+    /// in the zone at the end count neither as missed nor as not missed.
+    /// `None` (JSON `null`) when none has left; over seeds, the mean over
+    /// the runs where it is defined.
+    pub missed: Option<f64>,
     /// Σ realized AD at the next step / Σ the plan's `expected_by_step[0]`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub calibration: Option<f64>,
@@ -270,6 +335,10 @@ pub fn summarize(runs: &[Metrics]) -> (Metrics, Metrics) {
     (mean.d4s, ci.d4s) = field(runs, |m| m.d4s);
     (mean.cells, ci.cells) = field(runs, |m| m.cells);
     (mean.detected_once, ci.detected_once) = field(runs, |m| m.detected_once);
+    // Undefined in a run without a detected (or a departed) entrant: such a
+    // run has no figure to average, rather than a zero that is not one.
+    (mean.delay, ci.delay) = opt(runs, |m| m.delay);
+    (mean.missed, ci.missed) = opt(runs, |m| m.missed);
     (mean.calibration, ci.calibration) = opt(runs, |m| m.calibration);
     (mean.plan_ms_p50, ci.plan_ms_p50) = opt(runs, |m| m.plan_ms_p50);
     (mean.plan_ms_p99, ci.plan_ms_p99) = opt(runs, |m| m.plan_ms_p99);
@@ -313,7 +382,18 @@ mod tests {
             four_plus: 1,
             cells: 5,
         });
-        let m = acc.finish(0.5);
+        // Four entered, two detected (after 2 and 3 steps), three left, one
+        // of them undetected: the other undetected one is still in the zone.
+        let m = acc.finish(Entries {
+            entered: 4,
+            detected: 2,
+            delay_steps: 5,
+            left: 3,
+            left_undetected: 1,
+        });
+        assert_eq!(m.detected_once, 0.5);
+        assert_eq!(m.delay, Some(2.5));
+        assert_eq!(m.missed, Some(1.0 / 3.0));
         assert_eq!(m.ad, 3.0);
         assert_eq!(m.zd, 2.0);
         // Mean of 0.4 and 1.0, skipping the empty step.
@@ -337,7 +417,7 @@ mod tests {
             acc.add_plan_time(1.0);
             acc.add_plan_violations(pairs, per);
         }
-        let m = acc.finish(0.0);
+        let m = acc.finish(Entries::default());
         assert_eq!(m.violating_plans, Some(0.4));
         assert_eq!(m.violations_per_plan, Some(0.8));
         assert_eq!(m.violating_sensor_plans, Some(5.0 / 20.0));
@@ -376,7 +456,7 @@ mod tests {
                 micros: 1,
             });
         }
-        let m = acc.finish(0.0);
+        let m = acc.finish(Entries::default());
         assert!(m.gap_mean.is_some_and(|g| (g - 0.00175).abs() < 1e-15));
         // The nearest-rank median of four: the second smallest.
         assert_eq!(m.gap_p50, Some(0.001));
@@ -384,8 +464,59 @@ mod tests {
         assert_eq!(m.joint_at_target, Some(0.5));
         assert_eq!(m.joint_out_of_budget, Some(0.25));
         // A paper plan has no certificate, a non-joint plan no rounds.
-        let m = RunAccumulator::default().finish(0.0);
+        let m = RunAccumulator::default().finish(Entries::default());
         assert_eq!((m.gap_mean, m.gap_p50, m.joint_rounds), (None, None, None));
+    }
+
+    #[test]
+    fn delay_and_missed_are_undefined_without_targets_to_count() {
+        // Nothing entered: no fraction detected, no delay, nothing missed.
+        let none = Entries::default();
+        assert_eq!(
+            (none.detected_once(), none.delay(), none.missed()),
+            (0.0, None, None)
+        );
+        // Entered, none detected and none gone yet: no delay to average and
+        // no target that could count as missed.
+        let waiting = Entries {
+            entered: 3,
+            ..Entries::default()
+        };
+        assert_eq!((waiting.delay(), waiting.missed()), (None, None));
+        // Every one detected on the step it entered, all gone: delay 0,
+        // none missed.
+        let instant = Entries {
+            entered: 2,
+            detected: 2,
+            delay_steps: 0,
+            left: 2,
+            left_undetected: 0,
+        };
+        assert_eq!((instant.delay(), instant.missed()), (Some(0.0), Some(0.0)));
+    }
+
+    #[test]
+    fn delay_and_missed_average_over_the_runs_that_define_them() {
+        let run = |delay, missed| Metrics {
+            detected_once: 0.5,
+            delay,
+            missed,
+            ..Metrics::default()
+        };
+        let (mean, ci) = summarize(&[
+            run(Some(1.0), Some(0.25)),
+            run(Some(3.0), None),
+            run(None, Some(0.75)),
+            run(Some(2.0), Some(0.5)),
+        ]);
+        // Three delays and three fractions missed, not four with zeros.
+        assert_eq!(mean.delay, Some(2.0));
+        assert_eq!(mean.missed, Some(0.5));
+        assert_eq!(ci.delay, Some(mean_ci(&[1.0, 3.0, 2.0]).1));
+        assert_eq!(ci.missed, Some(mean_ci(&[0.25, 0.75, 0.5]).1));
+        assert_eq!((mean.detected_once, ci.detected_once), (0.5, 0.0));
+        let (mean, ci) = summarize(&[run(None, None), run(None, None)]);
+        assert_eq!((mean.delay, mean.missed, ci.delay), (None, None, None));
     }
 
     #[test]

@@ -19,7 +19,11 @@ fn opt(mean: Option<f64>, ci: Option<f64>, decimals: usize) -> String {
 
 /// The rows as a table: the paper's columns (EN NS AD ZD AF D1S D2S D3S,
 /// then D4+S, detected by four or more sensors, TV), then ours (policy,
-/// detected once, calibration, plan round trip p50/p99, distinct cells
+/// `once`: the fraction of the targets entering during the window detected
+/// at least once, `delay`: the mean steps from entry to first detection of
+/// those detected, `missed`: the fraction of those that left the zone never
+/// detected (`-` when no run defines them), calibration, plan round trip
+/// p50/p99, distinct cells
 /// occupied by the sensors, `viol%`: the percentage of plan responses with
 /// a separation violation, `sviol%`: the percentage of sensor plans
 /// with one, `-` for local policies, and `gap%` and `gap50%`: the mean and
@@ -30,11 +34,11 @@ fn opt(mean: Option<f64>, ci: Option<f64>, decimals: usize) -> String {
 /// half-width of its 95% confidence interval over seeds.
 pub fn table(rows: &[Row]) -> String {
     let header = [
-        "EN", "NS", "AD", "ZD", "AF", "D1S", "D2S", "D3S", "D4+S", "TV", "policy", "once", "calib",
-        "p50 ms", "p99 ms", "cells", "viol%", "sviol%", "gap%", "gap50%",
+        "EN", "NS", "AD", "ZD", "AF", "D1S", "D2S", "D3S", "D4+S", "TV", "policy", "once", "delay",
+        "missed", "calib", "p50 ms", "p99 ms", "cells", "viol%", "sviol%", "gap%", "gap50%",
     ];
     let percent = |x: Option<f64>| x.map(|x| 100.0 * x);
-    let body: Vec<[String; 20]> = rows
+    let body: Vec<[String; 22]> = rows
         .iter()
         .map(|r| {
             let (m, c) = (&r.metrics, &r.ci95);
@@ -52,6 +56,8 @@ pub fn table(rows: &[Row]) -> String {
                     .map_or_else(|| "mix".to_owned(), |v| v.to_string()),
                 r.policy.clone(),
                 pm(m.detected_once, c.detected_once, 2),
+                opt(m.delay, c.delay, 2),
+                opt(m.missed, c.missed, 2),
                 opt(m.calibration, c.calibration, 2),
                 opt(m.plan_ms_p50, c.plan_ms_p50, 2),
                 opt(m.plan_ms_p99, c.plan_ms_p99, 2),

@@ -288,6 +288,10 @@ function panel(f) {
   $("m-af").textContent = fmt(m.af, 2);
   $("m-af-mean").textContent = f.step ? fmt(m.af_mean, 3) : "–";
   $("m-once").textContent = f.step ? fmt(m.once, 3) : "–";
+  // Null until a counted target has been detected (delay) or has left the
+  // zone (missed): shown as "–", not as a zero.
+  $("m-delay").textContent = fmt(m.delay, 2);
+  $("m-missed").textContent = fmt(m.missed, 3);
   $("m-calib").textContent = fmt(m.calibration, 3);
   $("m-plan").textContent = fmt(m.plan_ms, 1);
   $("m-plan-mean").textContent = fmt(m.plan_ms_mean, 1);
@@ -304,6 +308,8 @@ function panel(f) {
   chart("c-ad", f.series.ad);
   chart("c-af", f.series.af, 1);
   chart("c-once", f.series.once, 1);
+  chart("c-delay", f.series.delay);
+  chart("c-missed", f.series.missed, 1);
   chart("c-calib", f.series.calibration);
   chart("c-plan", f.series.plan_ms);
   chart("c-gap", f.series.gap);

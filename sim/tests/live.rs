@@ -1,7 +1,8 @@
 //! The live view in a real browser: a headless Chromium driven through
 //! WebDriver (chromedriver, started here on a free port) opens the page of
 //! a live run served on a loopback port 0, and the DOM is checked: the step
-//! counter advances, every sensor is drawn, the metrics update, the plan's
+//! counter advances, every sensor is drawn, the metrics update (`delay`
+//! and `missed` among them, once the run defines them), the plan's
 //! certified gap is shown, pause stops the counter, step advances it by
 //! one, and the `explain` switch draws.
 //! A screenshot goes to the target directory.
@@ -191,6 +192,35 @@ async fn live_view_in_headless_chromium() {
             .parse()
             .unwrap_or_else(|_| panic!("#{id} is not a number: {text:?}"));
         assert!(v.is_finite() && v >= 0.0, "#{id} = {v}");
+    }
+
+    // `delay` and `missed` show "–" until a counted target has been
+    // detected and one has left the zone (within a zone crossing, a few
+    // dozen steps), then numbers, and their charts follow.
+    let number = |id: &'static str| {
+        let c = &c;
+        async move {
+            let text = c
+                .find(Locator::Id(id))
+                .await
+                .expect("metric")
+                .text()
+                .await
+                .expect("text");
+            text.parse::<f64>().ok()
+        }
+    };
+    until(20, "delay and missed to be defined", || async {
+        number("m-delay").await.is_some() && number("m-missed").await.is_some()
+    })
+    .await;
+    let delay = number("m-delay").await.expect("a delay");
+    let missed = number("m-missed").await.expect("a fraction missed");
+    assert!(delay.is_finite() && delay >= 0.0, "#m-delay = {delay}");
+    assert!((0.0..=1.0).contains(&missed), "#m-missed = {missed}");
+    for id in ["c-delay", "c-missed"] {
+        let chart = c.find(Locator::Id(id)).await.expect("chart");
+        assert!(int_attr(&chart, "data-points").await >= 1, "#{id}");
     }
 
     // An exact plan carries its certificate: the page shows each step's

@@ -471,6 +471,8 @@ fn the_command_line_takes_a_minimum_separation() {
     let columns: Vec<&str> = header.split_whitespace().collect();
     let col = |name| columns.iter().position(|&c| c == name);
     assert_eq!(col("D4+S"), col("D3S").map(|i| i + 1), "{header}");
+    assert_eq!(col("delay"), col("once").map(|i| i + 1), "{header}");
+    assert_eq!(col("missed"), col("once").map(|i| i + 2), "{header}");
     assert_eq!(
         &columns[columns.len() - 5..],
         ["cells", "viol%", "sviol%", "gap%", "gap50%"],
@@ -486,6 +488,14 @@ fn the_command_line_takes_a_minimum_separation() {
     assert!(run["metrics"]["violating_plans"].is_number());
     assert!(run["metrics"]["violations_per_plan"].is_number());
     assert!(run["metrics"]["violating_sensor_plans"].is_number());
+    // Four steps may leave no target detected or gone: null then, but
+    // always there.
+    for key in ["delay", "missed"] {
+        for part in ["metrics", "ci95"] {
+            let v = run[part].get(key).unwrap_or_else(|| panic!("{part}.{key}"));
+            assert!(v.is_null() || v.is_number(), "{part}.{key}: {v}");
+        }
+    }
     // The paper estimator has no certificate: no gap, shown as `-`.
     assert!(run["metrics"]["gap_mean"].is_null());
     let row = table.lines().nth(1).expect("a row");

@@ -166,6 +166,9 @@ async fn vigil_sim_through_sessions_gives_the_same_metrics() {
             stateless.detected_once, sessions.detected_once,
             "seed {seed}"
         );
+        assert_eq!(stateless.delay, sessions.delay, "seed {seed}");
+        assert_eq!(stateless.missed, sessions.missed, "seed {seed}");
+        assert!(stateless.delay.is_some() && stateless.missed.is_some());
         let (a, b) = (
             stateless.calibration.unwrap(),
             sessions.calibration.unwrap(),

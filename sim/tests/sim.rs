@@ -7,7 +7,9 @@ use vigil::stats::Stats;
 use vigil_sim::client::{Client, spawn_local_server};
 use vigil_sim::driver::{Sim, Start, default_warmup};
 use vigil_sim::experiment::{RunConfig, run_all, run_one};
+use vigil_sim::metrics::Entries;
 use vigil_sim::policy::{ALL_POLICIES, Policy, local_force_move};
+use vigil_sim::report;
 
 fn assert_legal(sim: &Sim) {
     for trace in &sim.trace {
@@ -147,7 +149,8 @@ fn local_force_attracts_and_repels() {
 
 /// A short run of every policy over HTTP against an in-process server:
 /// moves are legal (the driver checks each plan too), metrics are sane,
-/// and planner policies report calibration and round trips.
+/// planner policies report calibration and round trips, and the table and
+/// the JSON report carry `delay` and `missed`.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn end_to_end_over_http() {
     let base = spawn_local_server().await.expect("server");
@@ -179,6 +182,23 @@ async fn end_to_end_over_http() {
         assert_eq!(row.seeds, 2);
         assert!(m.ad + m.zd > 0.0, "{}: an empty zone", row.policy);
         assert!((0.0..=1.0).contains(&m.af) && (0.0..=1.0).contains(&m.detected_once));
+        // A run has a delay exactly when it detected an entering target,
+        // so the mean over seeds has one exactly when `once` is positive.
+        // Entry and first detection both fall within the 15 measured
+        // steps.
+        assert_eq!(m.delay.is_some(), m.detected_once > 0.0, "{}", row.policy);
+        assert!(
+            m.delay.is_none_or(|d| (0.0..=14.0).contains(&d)),
+            "{}: delay {:?}",
+            row.policy,
+            m.delay
+        );
+        assert!(
+            m.missed.is_none_or(|x| (0.0..=1.0).contains(&x)),
+            "{}: missed {:?}",
+            row.policy,
+            m.missed
+        );
         // Every detected target is seen by one, two, three, or four or more.
         assert!((m.d1s + m.d2s + m.d3s + m.d4s - m.ad).abs() < 1e-9);
         assert!(
@@ -198,10 +218,98 @@ async fn end_to_end_over_http() {
         // No separation asked for, none to violate.
         assert_eq!(m.violating_plans, planner.then_some(0.0), "{}", row.policy);
     }
+    // Some policy detects a target that entered within the 15 steps, so
+    // the checks of `delay` above, and of the JSON below, bite.
+    assert!(rows.iter().any(|r| r.metrics.delay.is_some()));
+
+    // The table has `delay` and `missed` right after `once`.
+    let table = report::table(&rows);
+    let header: Vec<&str> = table
+        .lines()
+        .next()
+        .expect("header")
+        .split_whitespace()
+        .collect();
+    let once = header.iter().position(|&c| c == "once").expect("once");
+    assert_eq!(header[once + 1..once + 3], ["delay", "missed"], "{table}");
+    // The JSON report has both in every row's means and intervals: a
+    // number, or null where no run defines it.
+    let json: serde_json::Value =
+        serde_json::from_str(&report::json(&rows).expect("JSON")).expect("parses");
+    for (run, row) in json["runs"].as_array().expect("runs").iter().zip(&rows) {
+        for (key, value) in [("delay", row.metrics.delay), ("missed", row.metrics.missed)] {
+            assert_eq!(run["metrics"].get(key).map(|v| v.as_f64()), Some(value));
+            let ci = run["ci95"].get(key).expect("an interval");
+            assert_eq!(ci.is_null(), value.is_none(), "{}: {key}", row.policy);
+        }
+    }
+
     for cfg in &configs {
         let (_, sim) = run_one(&client, cfg, 3, true).await.expect("run");
         assert_legal(&sim.expect("kept"));
     }
+}
+
+/// The counts behind `once`, `delay` and `missed` over whole runs of the
+/// local policies: they only grow, every missed target is one that left
+/// and was never detected, each delay fits in the steps measured so far,
+/// and the targets counted but not gone are those in the zone now that
+/// were not when the window started (counted here from the detections).
+#[test]
+fn entries_hold_together_over_runs() {
+    let s = builtins().remove(0);
+    let warmup = default_warmup(&s);
+    let (mut left, mut detected) = (0, 0);
+    for policy in [Policy::Stationary, Policy::Random, Policy::LocalForce] {
+        for seed in 0..4 {
+            let mut sim = Sim::new(s.clone(), 6, Start::Grid, seed, 16);
+            for _ in 0..warmup {
+                let stay = sim.sensors.clone();
+                sim.advance(stay);
+            }
+            sim.start_window();
+            let before: std::collections::HashSet<u64> =
+                sim.detections().iter().map(|d| d.0).collect();
+            let mut last = Entries::default();
+            for k in 1..=120 {
+                sim.observe();
+                let next = sim.local_moves(policy);
+                sim.advance(next);
+                let e = sim.entries();
+                let at = format!("{policy:?} seed {seed} step {k}: {e:?}");
+                for (now, was) in [
+                    (e.entered, last.entered),
+                    (e.detected, last.detected),
+                    (e.delay_steps, last.delay_steps),
+                    (e.left, last.left),
+                    (e.left_undetected, last.left_undetected),
+                ] {
+                    assert!(now >= was, "{at} after {last:?}");
+                }
+                assert!(e.detected <= e.entered && e.left <= e.entered, "{at}");
+                assert!(e.left_undetected <= e.left, "{at}");
+                assert!(e.left_undetected <= e.entered - e.detected, "{at}");
+                // Entered after step 0 of the window, detected by step k.
+                assert!(e.delay_steps <= e.detected * (k - 1), "{at}");
+                let new_in_zone = sim
+                    .detections()
+                    .iter()
+                    .filter(|d| !before.contains(&d.0))
+                    .count();
+                assert_eq!(e.entered - e.left, new_in_zone, "{at}");
+                assert_eq!(sim.detected_once(), e.detected_once(), "{at}");
+                assert_eq!((sim.delay(), sim.missed()), (e.delay(), e.missed()));
+                last = e;
+            }
+            left += last.left;
+            detected += last.detected;
+        }
+    }
+    // Enough happened for the checks to mean something.
+    assert!(
+        left > 100 && detected > 100,
+        "{left} left, {detected} detected"
+    );
 }
 
 // Fleets: sensor types, speeds, no-go zones and Bernoulli detections.
