@@ -24,7 +24,10 @@
 //! certificate's marginal bound holds for it.
 
 use super::ExactEstimator;
+use std::cell::RefCell;
+
 use crate::geometry::{Point, detection_pieces, detection_within};
+use crate::limits::MAX_HORIZON;
 use crate::scenario::{Cell, Look};
 use crate::search::{PathGain, ValueGrid};
 
@@ -74,26 +77,19 @@ impl Profile {
         &self.pieces[self.start[i] as usize..self.start[i + 1] as usize]
     }
 
-    /// `∫_a^b detected` over the `i`-th key's pieces.
-    fn detected(&self, i: usize, a: f64, b: f64) -> f64 {
-        let lo = self.start[i] as usize;
-        let pieces = &self.pieces[lo..self.start[i + 1] as usize];
-        let before = &self.before[lo..self.start[i + 1] as usize];
-        let upto = |x: f64| -> f64 {
-            // The first piece that ends after x.
-            let j = pieces.partition_point(|p| p.1 <= x);
-            match pieces.get(j) {
-                Some(&(x0, _, d)) if x > x0 => before[j] + (x - x0) * d,
-                Some(_) => before[j],
-                None => pieces
-                    .last()
-                    .map_or(0.0, |&(x0, x1, d)| before[pieces.len() - 1] + (x1 - x0) * d),
-            }
-        };
-        if pieces.is_empty() || b <= a {
-            return 0.0;
+    /// `∫_{−∞}^x detected` over the `i`-th key's pieces.
+    fn upto(&self, i: usize, x: f64) -> f64 {
+        let (lo, hi) = (self.start[i] as usize, self.start[i + 1] as usize);
+        let pieces = &self.pieces[lo..hi];
+        // The first piece that ends after x.
+        let j = pieces.partition_point(|p| p.1 <= x);
+        match pieces.get(j) {
+            Some(&(x0, _, d)) if x > x0 => self.before[lo + j] + (x - x0) * d,
+            Some(_) => self.before[lo + j],
+            None => pieces
+                .last()
+                .map_or(0.0, |&(x0, x1, d)| self.before[hi - 1] + (x1 - x0) * d),
         }
-        upto(b) - upto(a)
     }
 }
 
@@ -108,11 +104,11 @@ struct Background<'h> {
 }
 
 impl Background<'_> {
-    /// `∫_a^b detected` on `key`.
-    fn detected(&self, key: u32, a: f64, b: f64) -> f64 {
+    /// `∫_{−∞}^x detected` on `key`.
+    fn upto(&self, key: u32, x: f64) -> f64 {
         match self.keys.binary_search(&key) {
-            Ok(i) => self.merged.detected(i, a, b),
-            Err(_) => self.history.detected(key as usize, a, b),
+            Ok(i) => self.merged.upto(i, x),
+            Err(_) => self.history.upto(key as usize, x),
         }
     }
 }
@@ -307,7 +303,7 @@ impl<'e> FirstDetections<'e> {
         start: Cell,
         extra: &[Vec<Look>],
         grid: &mut ValueGrid,
-    ) -> PathCover<'_> {
+    ) -> PathCover {
         let s = self.est.scenario;
         let ty = self.est.types[sensor];
         let horizon = grid.horizon();
@@ -317,6 +313,7 @@ impl<'e> FirstDetections<'e> {
         let mut slots = vec![u32::MAX; horizon * side * side];
         let mut start_of = vec![0u32];
         let mut pieces: Vec<Piece> = Vec::new();
+        let mut ends: Vec<(f64, f64)> = Vec::new();
         let mut alone: Vec<f64> = Vec::new();
         let mut buf = Vec::new();
         let mut one = Vec::new();
@@ -333,7 +330,9 @@ impl<'e> FirstDetections<'e> {
                 self.pieces(&s.look(ty, k), t, &mut one, &mut buf);
                 let mut total = 0.0;
                 for p in &one {
-                    let g = p.w * p.p * ((p.b - p.a) - background.detected(p.key, p.a, p.b));
+                    let (ga, gb) = (background.upto(p.key, p.a), background.upto(p.key, p.b));
+                    let g = p.w * p.p * ((p.b - p.a) - (gb - ga));
+                    ends.push((ga, gb));
                     alone.push(g);
                     total += g;
                 }
@@ -346,13 +345,14 @@ impl<'e> FirstDetections<'e> {
             });
         }
         PathCover {
-            background,
             extent,
             side,
             slots,
             start_of,
             pieces,
+            ends,
             alone,
+            events: RefCell::new(Vec::new()),
         }
     }
 }
@@ -360,8 +360,7 @@ impl<'e> FirstDetections<'e> {
 /// One sensor's path gains for [`crate::search::best_path_bounded`]: what
 /// each stop of a path adds to the first detections of the history and the
 /// other sensors' looks, on top of the path's earlier stops.
-pub struct PathCover<'f> {
-    background: Background<'f>,
+pub struct PathCover {
     extent: i32,
     side: usize,
     /// Per (step, offset) of the grid, its stop's index, `u32::MAX` where
@@ -371,11 +370,17 @@ pub struct PathCover<'f> {
     /// sorted by key.
     start_of: Vec<u32>,
     pieces: Vec<Piece>,
+    /// Aligned with `pieces`: what the background detected up to each
+    /// one's ends (`∫_{−∞}^a` and `∫_{−∞}^b`), so that every integral over
+    /// parts of pieces, whose ends are pieces' ends, is a difference.
+    ends: Vec<(f64, f64)>,
     /// Aligned with `pieces`: each one's gain alone.
     alone: Vec<f64>,
+    /// Scratch space of the sweeps.
+    events: RefCell<Vec<(f64, f64, bool)>>,
 }
 
-impl PathCover<'_> {
+impl PathCover {
     /// The stop of step `t` (1-based) at offset `(dc, dr)`.
     fn stop(&self, t: usize, (dc, dr): (i32, i32)) -> std::ops::Range<usize> {
         let index = (t - 1) * self.side * self.side
@@ -391,43 +396,65 @@ impl PathCover<'_> {
     }
 }
 
-impl PathGain for PathCover<'_> {
+impl PathGain for PathCover {
     fn gain(&self, stops: &[(i32, i32)]) -> f64 {
         let t = stops.len();
         let mine = self.stop(t, stops[t - 1]);
-        let earlier: Vec<&[Piece]> = (1..t)
-            .map(|u| &self.pieces[self.stop(u, stops[u - 1])])
-            .collect();
-        let mut cursors = vec![0usize; earlier.len()];
-        let mut over: Vec<(f64, f64, f64)> = Vec::new();
-        let mut events = Vec::new();
+        // The earlier stops' pieces, and a cursor in each.
+        let mut earlier = [(0usize, 0usize); MAX_HORIZON];
+        for u in 1..t {
+            let r = self.stop(u, stops[u - 1]);
+            earlier[u - 1] = (r.start, r.end);
+        }
+        let earlier = &mut earlier[..t - 1];
+        let mut over = [(0.0, 0.0, 0.0); MAX_HORIZON];
+        // Pieces' ends and what the background detected up to each.
+        let mut known = [(0.0, 0.0); 2 * MAX_HORIZON + 2];
+        let mut events = self.events.borrow_mut();
         let mut total = 0.0;
         for i in mine {
             let x = self.pieces[i];
-            over.clear();
+            let mut n = 0;
             // Each earlier stop holds at most one piece per key; the pieces
             // are sorted by key, so one cursor per stop walks them once.
-            for (e, c) in earlier.iter().zip(cursors.iter_mut()) {
-                while *c < e.len() && e[*c].key < x.key {
+            for (c, end) in earlier.iter_mut() {
+                while *c < *end && self.pieces[*c].key < x.key {
                     *c += 1;
                 }
-                if let Some(q) = e
-                    .get(*c)
-                    .filter(|q| q.key == x.key && q.b > x.a && q.a < x.b)
-                {
-                    over.push((q.a, q.b, q.p));
+                if *c < *end {
+                    let q = self.pieces[*c];
+                    if q.key == x.key && q.b > x.a && q.a < x.b {
+                        over[n] = (q.a, q.b, q.p);
+                        let (ga, gb) = self.ends[*c];
+                        known[2 * n] = (q.a, ga);
+                        known[2 * n + 1] = (q.b, gb);
+                        n += 1;
+                    }
                 }
             }
-            if over.is_empty() {
+            if n == 0 {
                 total += self.alone[i];
                 continue;
             }
+            let (ga, gb) = self.ends[i];
+            known[2 * n] = (x.a, ga);
+            known[2 * n + 1] = (x.b, gb);
+            let known = &known[..2 * n + 2];
+            // Every end of a part below is one of these.
+            let g = |v: f64| known.iter().find(|k| k.0 == v).map_or(0.0, |k| k.1);
             // ∫ u·(1 − det_earlier) over the piece: its length less what is
             // detected already, less what the earlier stops detect of the rest.
-            let mut left = (x.b - x.a) - self.background.detected(x.key, x.a, x.b);
-            detection_pieces(&over, x.a, x.b, &mut events, |a, b, d| {
-                left -= d * ((b - a) - self.background.detected(x.key, a, b));
-            });
+            let mut left = (x.b - x.a) - (gb - ga);
+            if n == 1 {
+                // One earlier piece (the common case): no sweep.
+                let (a, b, d) = over[0];
+                let (lo, hi) = (a.max(x.a), b.min(x.b));
+                left -= d * ((hi - lo) - (g(hi) - g(lo)));
+            } else {
+                detection_pieces(&over[..n], x.a, x.b, &mut events, |a, b, d| {
+                    left -= d * ((b - a) - (g(b) - g(a)));
+                });
+            }
             total += x.w * x.p * left;
         }
         total
