@@ -18,7 +18,7 @@
 use std::collections::{HashMap, HashSet, VecDeque};
 
 use rand::{SeedableRng, rngs::StdRng};
-use vigil::coordination::{Bound, Coordination};
+use vigil::coordination::{Bound, Coordination, Objective};
 use vigil::geometry::Point;
 use vigil::planner::{
     EstimatorKind, Id, PlanRequest, PlanResponse, PositionIn, SensorIn, TargetIn,
@@ -463,7 +463,10 @@ impl Sim {
             estimator: settings.map(|p| p.estimator),
             coordination: settings.map(|p| p.coordination),
             observed: settings.map(|p| p.observed),
-            objective: None,
+            // Only when not the default, as `min_separation` below.
+            objective: settings
+                .map(|p| p.objective)
+                .filter(|&o| o != Objective::Detections),
             explain: None,
             // Only when set: requests otherwise stay as they were, and the
             // server applies the scenario's.
@@ -525,7 +528,9 @@ impl Sim {
             estimator: settings.map(|p| p.estimator),
             coordination: settings.map(|p| p.coordination),
             observed: settings.map(|p| p.observed),
-            objective: None,
+            objective: settings
+                .map(|p| p.objective)
+                .filter(|&o| o != Objective::Detections),
             min_separation: self.min_separation.map(Into::into),
             history_steps: Some(history.into()),
         }
@@ -654,6 +659,10 @@ impl Sim {
         for &(id, _, n) in &detections {
             if n > 0 {
                 count.detected += 1;
+                // `observe` records this step's detections after it.
+                if !self.last_seen.contains_key(&id) {
+                    count.first_detected += 1;
+                }
                 match count.by_exactly.get_mut(n - 1) {
                     Some(slot) => *slot += 1,
                     None => count.four_plus += 1,
@@ -721,11 +730,22 @@ mod tests {
         ];
         sim.start_window();
         let mut after = vec![Entries::default()];
+        let mut first = vec![0];
+        // Held in view since before the window: detected before step 1.
+        sim.sense();
+        sim.observe();
         for _ in 0..40 {
             let stay = sim.sensors.clone();
             let count = sim.advance(stay);
             assert!(count.detected >= 1, "step {}: the held target", sim.step);
+            sim.observe();
             after.push(sim.entries());
+            first.push(count.first_detected);
+        }
+        // Detected for the first time: the first target at step 5, the
+        // third at step 14, and nothing else ever.
+        for (step, &n) in first.iter().enumerate() {
+            assert_eq!(n, usize::from(step == 5 || step == 14), "step {step}");
         }
         let e = |entered, detected, delay_steps, left, left_undetected| Entries {
             entered,

@@ -7,11 +7,12 @@ use std::sync::Arc;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use tokio::sync::Semaphore;
+use vigil::coordination::Objective;
 use vigil::scenario::Scenario;
 
 use crate::client::{Client, ClientError};
 use crate::driver::{Sim, Start, checked_bound, fleet_types};
-use crate::metrics::{Metrics, RunAccumulator, summarize};
+use crate::metrics::{Metrics, RunAccumulator, StepCount, summarize};
 use crate::policy::{ALL_POLICIES, Policy};
 
 /// Everything that defines one run but its seed.
@@ -171,7 +172,7 @@ pub async fn run_one(
         let count = sim.advance(next);
         acc.add(count);
         if let Some(p) = predicted {
-            acc.add_calibration(p, count.detected);
+            acc.add_calibration(p, realized(cfg.policy, &count));
         }
     }
     if let Some(id) = &session {
@@ -179,6 +180,16 @@ pub async fn run_one(
     }
     let metrics = acc.finish(sim.entries());
     Ok((metrics, keep.then_some(sim)))
+}
+
+/// What a plan's first step predicts, as it happened: the targets detected
+/// (for a policy maximising first detections, those detected for the first
+/// time).
+pub fn realized(policy: Policy, count: &StepCount) -> usize {
+    match policy.planner().map(|p| p.objective) {
+        Some(Objective::FirstDetections) => count.first_detected,
+        _ => count.detected,
+    }
 }
 
 /// One row of a report: a configuration averaged over seeds.
@@ -377,7 +388,7 @@ mod tests {
         assert_eq!(
             two,
             Some(vec![
-                ('i', Policy::ExactJoint),
+                ('j', Policy::ExactJoint),
                 ('d', Policy::ExactIterated)
             ])
         );

@@ -696,7 +696,7 @@ async fn drive(shared: Arc<Shared>, client: Client, opts: LiveOptions) -> Result
         }
         if let Some(p) = predicted {
             run.predicted += p;
-            run.realized += count.detected as f64;
+            run.realized += crate::experiment::realized(cfg.policy, &count) as f64;
         }
         if let Some(ms) = plan_ms {
             run.plan_ms += ms;

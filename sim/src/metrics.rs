@@ -12,6 +12,9 @@ pub struct StepCount {
     pub in_zone: usize,
     /// Detected by at least one sensor.
     pub detected: usize,
+    /// Of those, the ones no sensor had detected at an earlier step: what
+    /// the intrusion objective's first step predicts.
+    pub first_detected: usize,
     /// Detected by exactly one, two, three sensors.
     pub by_exactly: [usize; 3],
     /// Detected by four or more sensors.
@@ -239,7 +242,9 @@ pub struct Metrics {
     /// `None` (JSON `null`) when none has left; over seeds, the mean over
     /// the runs where it is defined.
     pub missed: Option<f64>,
-    /// Σ realized AD at the next step / Σ the plan's `expected_by_step[0]`.
+    /// Σ realized AD at the next step / Σ the plan's `expected_by_step[0]`
+    /// (for a policy maximising first detections, the targets detected
+    /// for the first time at the next step).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub calibration: Option<f64>,
     /// Median plan round trip, ms.
@@ -364,6 +369,7 @@ mod tests {
         acc.add(StepCount {
             in_zone: 10,
             detected: 4,
+            first_detected: 4,
             by_exactly: [3, 1, 0],
             four_plus: 0,
             cells: 10,
@@ -371,6 +377,7 @@ mod tests {
         acc.add(StepCount {
             in_zone: 0,
             detected: 0,
+            first_detected: 0,
             by_exactly: [0, 0, 0],
             four_plus: 0,
             cells: 9,
@@ -378,6 +385,7 @@ mod tests {
         acc.add(StepCount {
             in_zone: 5,
             detected: 5,
+            first_detected: 5,
             by_exactly: [2, 1, 1],
             four_plus: 1,
             cells: 5,

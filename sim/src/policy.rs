@@ -4,7 +4,7 @@ use std::fmt;
 
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
-use vigil::coordination::Coordination;
+use vigil::coordination::{Coordination, Objective};
 use vigil::geometry::Point;
 use vigil::planner::{EstimatorKind, Observed};
 use vigil::scenario::{Cell, FovSpec, Scenario};
@@ -37,6 +37,9 @@ pub enum Policy {
     /// Exact, iterated, with every target in the zone reported: a reference
     /// ceiling, not something a real system can run.
     Clairvoyant,
+    /// Exact estimator, iterated coordination, maximising first detections
+    /// (the intrusion objective): each target not yet detected counts once.
+    ExactIntrusion,
 }
 
 /// The policies the experiments run by default, in report order: every
@@ -44,7 +47,7 @@ pub enum Policy {
 /// budget each, several times an iterated plan, so a grid of every policy
 /// would take several times as long; it is run by naming it
 /// (`--policy exact-joint`), after these in an experiment's rows.
-pub const ALL_POLICIES: [Policy; 8] = [
+pub const ALL_POLICIES: [Policy; 9] = [
     Policy::Paper,
     Policy::PaperUncoordinated,
     Policy::Exact,
@@ -53,6 +56,7 @@ pub const ALL_POLICIES: [Policy; 8] = [
     Policy::LocalForce,
     Policy::Random,
     Policy::Stationary,
+    Policy::ExactIntrusion,
 ];
 
 /// How a planner policy calls the planner.
@@ -64,6 +68,8 @@ pub struct PlannerSettings {
     pub coordination: Coordination,
     /// What the reported targets cover.
     pub observed: Observed,
+    /// What the plans maximise.
+    pub objective: Objective,
 }
 
 impl Policy {
@@ -79,11 +85,18 @@ impl Policy {
             Policy::ExactIterated => (E::Exact, C::Iterated, Observed::Sensors),
             Policy::ExactJoint => (E::Exact, C::Joint, Observed::Sensors),
             Policy::Clairvoyant => (E::Exact, C::Iterated, Observed::Zone),
+            Policy::ExactIntrusion => (E::Exact, C::Iterated, Observed::Sensors),
+        };
+        let objective = if self == Policy::ExactIntrusion {
+            Objective::FirstDetections
+        } else {
+            Objective::Detections
         };
         Some(PlannerSettings {
             estimator,
             coordination,
             observed,
+            objective,
         })
     }
 
@@ -99,6 +112,7 @@ impl Policy {
             Policy::ExactIterated => "exact-iterated",
             Policy::ExactJoint => "exact-joint",
             Policy::Clairvoyant => "clairvoyant",
+            Policy::ExactIntrusion => "exact-intrusion",
         }
     }
 }
