@@ -71,7 +71,7 @@ use crate::limits::MAX_SENSOR_SPEED;
 mod bound;
 mod motion;
 
-pub use bound::{Bounded, PathGain, best_path_bounded};
+pub use bound::{Bounded, PathGain, Stop, best_path_bounded};
 use motion::Motion;
 pub use motion::{MOVES, step_displacements};
 

@@ -217,11 +217,16 @@ pub struct FirstSearch {
     pub current: Option<(f64, u32)>,
 }
 
-/// Gains a first-detections search evaluates at most: every path of a
-/// speed-1 sensor up to T = 4 (9 + 9² + 9³ + 9⁴ = 7,380 prefixes) fits,
-/// so those searches are exact; beyond, the search keeps the best path
-/// found and its bound.
+/// Gains a first-detections search evaluates at most past its pairs (see
+/// [`crate::search::best_path_bounded`]) up to T = 4: every path of a
+/// speed-1 sensor (9 + 9² + 9³ + 9⁴ = 7,380 prefixes) fits, so those
+/// searches are exact.
 pub const FIRST_SEARCH_BUDGET: usize = 20_000;
+
+/// The same beyond T = 4, where the search is an approximation: the pair
+/// programme's path, improved by a short search (its loss is measured in
+/// `docs/intrusion.md`).
+pub const FIRST_SEARCH_BUDGET_LONG: usize = 1_000;
 
 impl Fleet<'_> {
     /// Every look of `sensors` on `paths`, per step 1..=T.
@@ -260,7 +265,12 @@ impl Fleet<'_> {
             &mut grid,
         );
         mark_too_close(&mut grid, self.starts[i], self.min_separation, avoid);
-        let found = best_path_bounded(&grid, &cover, FIRST_SEARCH_BUDGET);
+        let budget = if self.horizon <= 4 {
+            FIRST_SEARCH_BUDGET
+        } else {
+            FIRST_SEARCH_BUDGET_LONG
+        };
+        let found = best_path_bounded(&grid, &cover, budget);
         let current = current.and_then(|path| {
             let moves = path_moves(self.starts[i], path);
             let violations = grid.path_violations(&moves)?;

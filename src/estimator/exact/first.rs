@@ -25,11 +25,12 @@
 
 use super::ExactEstimator;
 use std::cell::RefCell;
+use std::sync::OnceLock;
 
 use crate::geometry::{Point, detection_pieces, detection_within};
 use crate::limits::MAX_HORIZON;
 use crate::scenario::{Cell, Look};
-use crate::search::{PathGain, ValueGrid};
+use crate::search::{PathGain, Stop, ValueGrid};
 
 /// A look's interval on one (class, ray), pulled back to step 0.
 #[derive(Debug, Clone, Copy)]
@@ -93,24 +94,13 @@ impl Profile {
     }
 }
 
-/// What is detected already, per key: the history's seen sets, and over
-/// them, for the keys some extra look meets, the extra looks' pieces.
+/// What the extra looks of a search detect over the history, for the keys
+/// they meet: per key, the merged profile of both.
 #[derive(Debug)]
-struct Background<'h> {
-    history: &'h Profile,
+struct Background {
     /// Sorted keys with extra pieces, and their merged profiles.
     keys: Vec<u32>,
     merged: Profile,
-}
-
-impl Background<'_> {
-    /// `∫_{−∞}^x detected` on `key`.
-    fn upto(&self, key: u32, x: f64) -> f64 {
-        match self.keys.binary_search(&key) {
-            Ok(i) => self.merged.upto(i, x),
-            Err(_) => self.history.upto(key as usize, x),
-        }
-    }
 }
 
 /// The first-detections objective of one exact estimator's situation (see
@@ -124,6 +114,8 @@ pub struct FirstDetections<'e> {
     classes_of_rays: Vec<std::ops::Range<usize>>,
     /// The history's seen sets, one key each.
     history: Profile,
+    /// Per sensor, its stops (see [`FirstDetections::stops`]).
+    stops: Vec<OnceLock<Stops>>,
 }
 
 impl<'e> FirstDetections<'e> {
@@ -163,6 +155,7 @@ impl<'e> FirstDetections<'e> {
             key_start,
             classes_of_rays,
             history,
+            stops: (0..est.types.len()).map(|_| OnceLock::new()).collect(),
         }
     }
 
@@ -255,7 +248,7 @@ impl<'e> FirstDetections<'e> {
 
     /// The background of a search: the history, and over it `extra`'s
     /// looks (`extra[t − 1]` taken at step `t`).
-    fn background(&self, extra: &[Vec<Look>]) -> Background<'_> {
+    fn background(&self, extra: &[Vec<Look>]) -> Background {
         let mut buf = Vec::new();
         let mut pieces = Vec::new();
         for (t, step) in extra.iter().enumerate() {
@@ -286,11 +279,53 @@ impl<'e> FirstDetections<'e> {
             keys.push(key);
             merged.push_key(out);
         }
-        Background {
-            history: &self.history,
-            keys,
-            merged,
-        }
+        Background { keys, merged }
+    }
+
+    /// Sensor `sensor`'s stops on the cells of `grid`'s motion around
+    /// `start`: built on the first search of the sensor, and shared by the
+    /// later ones (a sensor's start, type and motion are the same in every
+    /// search of a plan).
+    fn stops(&self, sensor: usize, start: Cell, grid: &ValueGrid) -> &Stops {
+        self.stops[sensor].get_or_init(|| {
+            let s = self.est.scenario;
+            let ty = self.est.types[sensor];
+            let horizon = grid.horizon();
+            let extent = (grid.speed() * horizon) as i32;
+            let side = grid.side();
+            let mut stops = Stops {
+                extent,
+                side,
+                slots: vec![u32::MAX; horizon * side * side],
+                start_of: vec![0],
+                pieces: Vec::new(),
+                history_ends: Vec::new(),
+            };
+            let mut buf = Vec::new();
+            for t in 1..=horizon {
+                grid.for_each_reachable(t, |dc, dr| {
+                    let k = Cell {
+                        col: start.col + dc,
+                        row: start.row + dr,
+                    };
+                    if !s.on_lattice(k) {
+                        return;
+                    }
+                    let first = stops.pieces.len();
+                    self.pieces(&s.look(ty, k), t, &mut stops.pieces, &mut buf);
+                    stops
+                        .history_ends
+                        .extend(stops.pieces[first..].iter().map(|p| {
+                            let key = p.key as usize;
+                            (self.history.upto(key, p.a), self.history.upto(key, p.b))
+                        }));
+                    let index = stops.index(t, (dc, dr));
+                    stops.slots[index] = (stops.start_of.len() - 1) as u32;
+                    stops.start_of.push(stops.pieces.len() as u32);
+                });
+            }
+            stops
+        })
     }
 
     /// The gains of sensor `sensor`'s stops (see [`PathCover`]) on the
@@ -303,53 +338,46 @@ impl<'e> FirstDetections<'e> {
         start: Cell,
         extra: &[Vec<Look>],
         grid: &mut ValueGrid,
-    ) -> PathCover {
-        let s = self.est.scenario;
-        let ty = self.est.types[sensor];
-        let horizon = grid.horizon();
-        let extent = (grid.speed() * horizon) as i32;
-        let side = grid.side();
+    ) -> PathCover<'_> {
+        let stops = self.stops(sensor, start, grid);
         let background = self.background(extra);
-        let mut slots = vec![u32::MAX; horizon * side * side];
-        let mut start_of = vec![0u32];
-        let mut pieces: Vec<Piece> = Vec::new();
-        let mut ends: Vec<(f64, f64)> = Vec::new();
-        let mut alone: Vec<f64> = Vec::new();
-        let mut buf = Vec::new();
-        let mut one = Vec::new();
-        for t in 1..=horizon {
+        // Which keys the extra looks touch: their ends move; the others'
+        // are the history's.
+        let mut overlay = vec![u32::MAX; self.history.start.len().saturating_sub(1)];
+        for (i, &key) in background.keys.iter().enumerate() {
+            overlay[key as usize] = i as u32;
+        }
+        let ends: Vec<(f64, f64)> = stops
+            .pieces
+            .iter()
+            .zip(&stops.history_ends)
+            .map(|(p, &history)| match overlay[p.key as usize] {
+                u32::MAX => history,
+                i => (
+                    background.merged.upto(i as usize, p.a),
+                    background.merged.upto(i as usize, p.b),
+                ),
+            })
+            .collect();
+        let alone: Vec<f64> = stops
+            .pieces
+            .iter()
+            .zip(&ends)
+            .map(|(p, &(ga, gb))| p.w * p.p * ((p.b - p.a) - (gb - ga)))
+            .collect();
+        for t in 1..=grid.horizon() {
             grid.fill_step(t, |dc, dr| {
-                let k = Cell {
-                    col: start.col + dc,
-                    row: start.row + dr,
-                };
-                if !s.on_lattice(k) {
-                    return None;
-                }
-                one.clear();
-                self.pieces(&s.look(ty, k), t, &mut one, &mut buf);
-                let mut total = 0.0;
-                for p in &one {
-                    let (ga, gb) = (background.upto(p.key, p.a), background.upto(p.key, p.b));
-                    let g = p.w * p.p * ((p.b - p.a) - (gb - ga));
-                    ends.push((ga, gb));
-                    alone.push(g);
-                    total += g;
-                }
-                pieces.extend_from_slice(&one);
-                let index =
-                    (t - 1) * side * side + (dr + extent) as usize * side + (dc + extent) as usize;
-                slots[index] = (start_of.len() - 1) as u32;
-                start_of.push(pieces.len() as u32);
-                Some(total)
+                let i = stops.slots[stops.index(t, (dc, dr))];
+                (i != u32::MAX).then(|| {
+                    alone[stops.start_of[i as usize] as usize
+                        ..stops.start_of[i as usize + 1] as usize]
+                        .iter()
+                        .sum()
+                })
             });
         }
         PathCover {
-            extent,
-            side,
-            slots,
-            start_of,
-            pieces,
+            stops,
             ends,
             alone,
             events: RefCell::new(Vec::new()),
@@ -357,10 +385,10 @@ impl<'e> FirstDetections<'e> {
     }
 }
 
-/// One sensor's path gains for [`crate::search::best_path_bounded`]: what
-/// each stop of a path adds to the first detections of the history and the
-/// other sensors' looks, on top of the path's earlier stops.
-pub struct PathCover {
+/// One sensor's stops: every (step, cell) of its reach with the pieces of
+/// its look there, and what the history detected up to their ends.
+#[derive(Debug)]
+struct Stops {
     extent: i32,
     side: usize,
     /// Per (step, offset) of the grid, its stop's index, `u32::MAX` where
@@ -370,59 +398,78 @@ pub struct PathCover {
     /// sorted by key.
     start_of: Vec<u32>,
     pieces: Vec<Piece>,
-    /// Aligned with `pieces`: what the background detected up to each
-    /// one's ends (`∫_{−∞}^a` and `∫_{−∞}^b`), so that every integral over
-    /// parts of pieces, whose ends are pieces' ends, is a difference.
+    /// Aligned with `pieces`: `∫_{−∞}^a` and `∫_{−∞}^b` of what the history
+    /// detected.
+    history_ends: Vec<(f64, f64)>,
+}
+
+impl Stops {
+    /// The slot of step `t` (1-based) at offset `(dc, dr)`.
+    fn index(&self, t: usize, (dc, dr): (i32, i32)) -> usize {
+        (t - 1) * self.side * self.side
+            + (dr + self.extent) as usize * self.side
+            + (dc + self.extent) as usize
+    }
+
+    /// The pieces' indices of the stop of step `t` at offset `(dc, dr)`.
+    fn stop(&self, t: usize, offset: (i32, i32)) -> std::ops::Range<usize> {
+        let i = self.slots[self.index(t, offset)] as usize;
+        self.start_of[i] as usize..self.start_of[i + 1] as usize
+    }
+}
+
+/// One sensor's path gains for [`crate::search::best_path_bounded`]: what
+/// each stop of a path adds to the first detections of the history and the
+/// other sensors' looks, on top of the path's earlier stops.
+pub struct PathCover<'s> {
+    stops: &'s Stops,
+    /// Aligned with the stops' pieces: what the background detected up to
+    /// each one's ends (`∫_{−∞}^a` and `∫_{−∞}^b`), so that every integral
+    /// over parts of pieces, whose ends are pieces' ends, is a difference.
     ends: Vec<(f64, f64)>,
-    /// Aligned with `pieces`: each one's gain alone.
+    /// Aligned with the stops' pieces: each one's gain alone.
     alone: Vec<f64>,
     /// Scratch space of the sweeps.
     events: RefCell<Vec<(f64, f64, bool)>>,
 }
 
-impl PathCover {
-    /// The stop of step `t` (1-based) at offset `(dc, dr)`.
-    fn stop(&self, t: usize, (dc, dr): (i32, i32)) -> std::ops::Range<usize> {
-        let index = (t - 1) * self.side * self.side
-            + (dr + self.extent) as usize * self.side
-            + (dc + self.extent) as usize;
-        let i = self.slots[index] as usize;
-        self.start_of[i] as usize..self.start_of[i + 1] as usize
-    }
-
+impl PathCover<'_> {
     /// The exact value of a whole path (offsets of steps 1, 2, …).
-    pub fn value(&self, stops: &[(i32, i32)]) -> f64 {
-        (1..=stops.len()).map(|t| self.gain(&stops[..t])).sum()
+    pub fn value(&self, path: &[(i32, i32)]) -> f64 {
+        let stops: Vec<Stop> = path.iter().enumerate().map(|(i, &o)| (i + 1, o)).collect();
+        (0..stops.len())
+            .map(|i| self.gain(i + 1, path[i], &stops[..i]))
+            .sum()
     }
 }
 
-impl PathGain for PathCover {
-    fn gain(&self, stops: &[(i32, i32)]) -> f64 {
-        let t = stops.len();
-        let mine = self.stop(t, stops[t - 1]);
+impl PathGain for PathCover<'_> {
+    fn gain(&self, t: usize, at: (i32, i32), before: &[Stop]) -> f64 {
+        let pieces = &self.stops.pieces;
+        let mine = self.stops.stop(t, at);
         // The earlier stops' pieces, and a cursor in each.
         let mut earlier = [(0usize, 0usize); MAX_HORIZON];
-        for u in 1..t {
-            let r = self.stop(u, stops[u - 1]);
-            earlier[u - 1] = (r.start, r.end);
+        for (e, &(u, off)) in earlier.iter_mut().zip(before) {
+            let r = self.stops.stop(u, off);
+            *e = (r.start, r.end);
         }
-        let earlier = &mut earlier[..t - 1];
+        let earlier = &mut earlier[..before.len()];
         let mut over = [(0.0, 0.0, 0.0); MAX_HORIZON];
         // Pieces' ends and what the background detected up to each.
         let mut known = [(0.0, 0.0); 2 * MAX_HORIZON + 2];
         let mut events = self.events.borrow_mut();
         let mut total = 0.0;
         for i in mine {
-            let x = self.pieces[i];
+            let x = pieces[i];
             let mut n = 0;
             // Each earlier stop holds at most one piece per key; the pieces
             // are sorted by key, so one cursor per stop walks them once.
             for (c, end) in earlier.iter_mut() {
-                while *c < *end && self.pieces[*c].key < x.key {
+                while *c < *end && pieces[*c].key < x.key {
                     *c += 1;
                 }
                 if *c < *end {
-                    let q = self.pieces[*c];
+                    let q = pieces[*c];
                     if q.key == x.key && q.b > x.a && q.a < x.b {
                         over[n] = (q.a, q.b, q.p);
                         let (ga, gb) = self.ends[*c];
