@@ -59,7 +59,7 @@
 //! | paper: cells × ov² | 9.092e-6 | the excluded area's cover |
 //! | paper iterated: cells × n × (1 + ov) | 7.370e-6 | every lower-ranked sensor's change |
 
-use crate::coordination::Coordination;
+use crate::coordination::{Coordination, Objective};
 use crate::estimator::{
     INDEX_CROSSINGS_PER_CELL, MAX_SMALL_GRID, MIN_INDEX_CROSSINGS, ONE_WINDOW_RECTANGLES,
     SourceRays,
@@ -217,6 +217,11 @@ pub fn precompute_ms(s: &Scenario) -> f64 {
 /// O(sensors² + targets + history) to compute (microseconds).
 pub fn plan_ms(planner: &Planner, input: &PlanInput) -> f64 {
     let work = dot(&PLAN_MODEL, &plan_terms(planner, input).to_array()).max(FLOOR_MS);
+    if input.objective == Objective::FirstDetections {
+        // Its searches, not the model's fill and programme, are the work
+        // (and `joint` runs as `iterated`).
+        return work + FIRST_DETECTIONS_MS_PER_PAIR * first_detection_pairs(planner, input);
+    }
     // `joint` may use all of its budget on top of `iterated`'s work.
     match (input.coordination, input.estimator) {
         (Coordination::Joint, EstimatorKind::Exact) => {
@@ -224,6 +229,32 @@ pub fn plan_ms(planner: &Planner, input: &PlanInput) -> f64 {
         }
         _ => work,
     }
+}
+
+/// Milliseconds per pair gain of a sensor's reach in a first-detections
+/// plan: a rough one-term model, fitted on the reference workload with
+/// iterated coordination (10 sensors, T = 3: 3,150 pairs, 64 ms; at T = 8,
+/// 61,200 pairs, it predicts 1,242 ms against 1,339 measured; see
+/// `docs/intrusion.md`). Every search of a sensor computes its pairs, and
+/// the branch and bound past them grows with them.
+const FIRST_DETECTIONS_MS_PER_PAIR: f64 = 0.0203;
+
+/// The pair gains of every sensor's reach: `(2m+1)²` successors of each
+/// offset a sensor of speed `m` may stand on before each step, the lattice's
+/// edges ignored (an overestimate near them).
+fn first_detection_pairs(planner: &Planner, input: &PlanInput) -> f64 {
+    let s = &planner.scenario;
+    input
+        .types()
+        .iter()
+        .map(|&ty| {
+            let m = s.types[ty].speed as f64;
+            let successors = (2.0 * m + 1.0).powi(2);
+            (0..input.horizon)
+                .map(|t| (2.0 * m * t as f64 + 1.0).powi(2) * successors)
+                .sum::<f64>()
+        })
+        .sum()
 }
 
 /// The least either model predicts: every term can be 0 (sources that
@@ -620,6 +651,23 @@ mod tests {
         (spec.zone.width, spec.zone.height, spec.cell_size, spec.fov) = (w, w, cell, fov);
         spec.sources = (0..k).map(src).collect();
         Scenario::new(spec).expect("a valid scenario")
+    }
+
+    /// First detections cost what their searches do: far above the
+    /// detections objective's plan of the same request, growing with the
+    /// horizon, and above the time a server would plan on its async
+    /// worker (`INLINE_PLAN_MS`, 5 ms), so they never block it.
+    #[test]
+    fn first_detections_are_predicted_by_their_searches() {
+        let p = Planner::new(builtins().remove(0));
+        let first = |t: usize| {
+            let mut req = request(&p.scenario, 10, t, 30, 16);
+            req.objective = Some(Objective::FirstDetections);
+            plan_cost(&p, req, Iterated)
+        };
+        let j = plan_cost(&p, request(&p.scenario, 10, 3, 30, 16), Iterated);
+        assert!(first(3) > 20.0 * j && first(3) > 5.0, "{} vs {j}", first(3));
+        increasing("first detections by horizon", [3, 5, 8].map(first));
     }
 
     fn increasing(what: &str, costs: impl IntoIterator<Item = f64>) {
