@@ -20,6 +20,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use serde::Serialize;
 use std::sync::Arc;
 
+use vigil::coordination::{Coordination, Objective};
 use vigil::planner::{PlanRequest, Planner};
 
 use vigil_loadtest::certify;
@@ -125,9 +126,35 @@ struct WorkloadArgs {
     /// Seed of the simulated target process, and of the Poisson arrivals.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Objective every request asks for (`detections` or
+    /// `first_detections`); the requests' own by default. The states are
+    /// the same either way.
+    #[arg(long, value_parser = parse_objective)]
+    objective: Option<Objective>,
+    /// Coordination every request asks for (`none`, `priority`,
+    /// `iterated`, `joint`); the requests' own by default.
+    #[arg(long, value_parser = parse_coordination)]
+    coordination: Option<Coordination>,
+}
+
+fn parse_objective(s: &str) -> Result<Objective, String> {
+    serde_json::from_value(serde_json::Value::String(s.to_owned())).map_err(|e| e.to_string())
+}
+
+fn parse_coordination(s: &str) -> Result<Coordination, String> {
+    serde_json::from_value(serde_json::Value::String(s.to_owned())).map_err(|e| e.to_string())
 }
 
 impl WorkloadArgs {
+    /// `reqs` with the objective and coordination asked for.
+    fn override_settings(&self, mut reqs: Vec<PlanRequest>) -> Vec<PlanRequest> {
+        for req in &mut reqs {
+            req.objective = self.objective.or(req.objective);
+            req.coordination = self.coordination.or(req.coordination);
+        }
+        reqs
+    }
+
     fn workload(&self) -> Workload {
         Workload {
             sensors: self.sensors,
@@ -139,6 +166,12 @@ impl WorkloadArgs {
 
     /// The requests: read from `file`, or generated.
     fn requests(&self, file: Option<&Path>) -> Result<Vec<PlanRequest>> {
+        self.requests_as_given(file)
+            .map(|reqs| self.override_settings(reqs))
+    }
+
+    /// The requests: read from `file`, or generated, as they are.
+    fn requests_as_given(&self, file: Option<&Path>) -> Result<Vec<PlanRequest>> {
         match file {
             Some(f) => requests::load(f),
             None => {
