@@ -106,6 +106,58 @@ fn free_point(rng: &mut StdRng, s: &Scenario) -> (f64, f64) {
     }
 }
 
+/// A request's random state on `s`: `n` sensors on free cells, each of a
+/// type drawn from `names` (`default` for one the scenario lacks), up to
+/// `max_targets − 1` targets and up to two steps of history.
+fn random_state(
+    rng: &mut StdRng,
+    s: &Scenario,
+    n: usize,
+    names: &[&str],
+    max_targets: usize,
+) -> PlanRequest {
+    let sensors = (0..n)
+        .map(|i| {
+            let (x, y) = free_point(rng, s);
+            let ty = names[rng.random_range(0..names.len())];
+            SensorIn {
+                id: Id::Text(format!("s{i}")),
+                x,
+                y,
+                sensor_type: Some(ty.to_owned()).filter(|t| s.type_index(t).is_some()),
+            }
+        })
+        .collect();
+    let targets = (0..rng.random_range(0..max_targets))
+        .map(|_| {
+            let (x, y) = free_point(rng, s);
+            TargetIn {
+                id: None,
+                x,
+                y,
+                vx: rng.random_range(-10.0..10.0),
+                vy: rng.random_range(-10.0..10.0),
+            }
+        })
+        .collect();
+    let history = (0..rng.random_range(0..3))
+        .map(|_| {
+            (0..n)
+                .map(|_| {
+                    let (x, y) = free_point(rng, s);
+                    PositionIn::at(x, y)
+                })
+                .collect()
+        })
+        .collect();
+    PlanRequest {
+        sensors,
+        targets,
+        history: Some(history),
+        ..PlanRequest::default()
+    }
+}
+
 /// Every legal path of sensor `i` of `input` over `horizon` steps, by
 /// depth-first search over the displacements within its speed onto free
 /// cells, kept when the motion tables allow each step (no-go ground may
@@ -232,43 +284,7 @@ fn plans_are_below_the_optimum_and_the_optimum_below_the_bound() {
         };
         let planner = Planner::new(s);
         let s = &planner.scenario;
-        let sensors: Vec<SensorIn> = (0..n)
-            .map(|i| {
-                let (x, y) = free_point(&mut rng, s);
-                SensorIn {
-                    id: Id::Text(format!("s{i}")),
-                    x,
-                    y,
-                    sensor_type: Some(names[rng.random_range(0..names.len())].to_owned()),
-                }
-            })
-            .collect();
-        let targets = (0..rng.random_range(0..4))
-            .map(|_| {
-                let (x, y) = free_point(&mut rng, s);
-                TargetIn {
-                    id: None,
-                    x,
-                    y,
-                    vx: rng.random_range(-10.0..10.0),
-                    vy: rng.random_range(-10.0..10.0),
-                }
-            })
-            .collect();
-        let history = (0..rng.random_range(0..3))
-            .map(|_| {
-                (0..n)
-                    .map(|_| {
-                        let (x, y) = free_point(&mut rng, s);
-                        PositionIn::at(x, y)
-                    })
-                    .collect()
-            })
-            .collect::<Vec<_>>();
         let req = PlanRequest {
-            sensors,
-            targets,
-            history: Some(history),
             horizon: Some(horizon.into()),
             estimator: Some(EstimatorKind::Exact),
             // A separation in a third of the instances: the bound ignores
@@ -276,7 +292,7 @@ fn plans_are_below_the_optimum_and_the_optimum_below_the_bound() {
             min_separation: Some(if instances % 3 == 2 { 2usize } else { 0 }.into()),
             gap_target: Some(0.0),
             budget_ms: Some(200usize.into()),
-            ..PlanRequest::default()
+            ..random_state(&mut rng, s, n, &names, 4)
         };
         let input = PlanInput::new(s, &req).unwrap();
         let evaluator = Evaluator::new(&planner, &input, &CancelToken::never()).unwrap();
@@ -384,49 +400,12 @@ fn first_detection_plans_are_below_the_optimum_and_the_optimum_below_the_bound()
         let planner = Planner::new(s);
         let s = &planner.scenario;
         let names = ["default", "wide", "fast"];
-        let sensors: Vec<SensorIn> = (0..n)
-            .map(|i| {
-                let (x, y) = free_point(&mut rng, s);
-                let ty = names[rng.random_range(0..names.len())];
-                SensorIn {
-                    id: Id::Text(format!("s{i}")),
-                    x,
-                    y,
-                    sensor_type: Some(ty.to_owned()).filter(|t| s.type_index(t).is_some()),
-                }
-            })
-            .collect();
-        let targets = (0..rng.random_range(0..3))
-            .map(|_| {
-                let (x, y) = free_point(&mut rng, s);
-                TargetIn {
-                    id: None,
-                    x,
-                    y,
-                    vx: rng.random_range(-10.0..10.0),
-                    vy: rng.random_range(-10.0..10.0),
-                }
-            })
-            .collect();
-        let history = (0..rng.random_range(0..3))
-            .map(|_| {
-                (0..n)
-                    .map(|_| {
-                        let (x, y) = free_point(&mut rng, s);
-                        PositionIn::at(x, y)
-                    })
-                    .collect()
-            })
-            .collect::<Vec<_>>();
         let req = PlanRequest {
-            sensors,
-            targets,
-            history: Some(history),
             horizon: Some(horizon.into()),
             estimator: Some(EstimatorKind::Exact),
             objective: Some(Objective::FirstDetections),
             min_separation: Some(if instance % 4 == 3 { 2usize } else { 0 }.into()),
-            ..PlanRequest::default()
+            ..random_state(&mut rng, s, n, &names, 3)
         };
         let input = PlanInput::new(s, &req).unwrap();
         let evaluator = Evaluator::new(&planner, &input, &CancelToken::never()).unwrap();

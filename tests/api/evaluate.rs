@@ -5,27 +5,8 @@ use reqwest::StatusCode;
 use serde_json::{Value, json};
 
 use crate::helpers::{
-    assert_problem, assert_validation, close, json_body, plan_request, spawn_app,
+    assert_problem, assert_validation, close, json_body, paths_of, plan_request, spawn_app,
 };
-
-/// The paths of a plan response, as an evaluate request's `paths`.
-fn paths_of(plan: &Value) -> Value {
-    Value::Array(
-        plan["plans"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|p| {
-                json!({
-                    "sensor": p["sensor"],
-                    "path": p["path"].as_array().unwrap().iter()
-                        .map(|c| json!({"col": c["col"], "row": c["row"]}))
-                        .collect::<Vec<_>>(),
-                })
-            })
-            .collect(),
-    )
-}
 
 #[tokio::test]
 async fn a_plans_own_paths_score_its_value_and_marginals_add_up() {

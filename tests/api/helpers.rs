@@ -160,6 +160,25 @@ pub fn plan_request() -> Value {
     vigil::http::doc::examples::plan_request()
 }
 
+/// The paths of a plan response, as an evaluate request's `paths`.
+pub fn paths_of(plan: &Value) -> Value {
+    Value::Array(
+        plan["plans"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| {
+                json!({
+                    "sensor": p["sensor"],
+                    "path": p["path"].as_array().unwrap().iter()
+                        .map(|c| json!({"col": c["col"], "row": c["row"]}))
+                        .collect::<Vec<_>>(),
+                })
+            })
+            .collect(),
+    )
+}
+
 /// `a` and `b` agree within `rel` relative error.
 pub fn close(a: f64, b: f64, rel: f64) -> bool {
     (a - b).abs() <= rel * a.abs().max(b.abs()).max(f64::MIN_POSITIVE)

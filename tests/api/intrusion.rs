@@ -5,28 +5,9 @@ use reqwest::{StatusCode, header};
 use serde_json::{Value, json};
 
 use crate::helpers::{
-    assert_problem, assert_validation, close, json_body, plan_request, small_spec, spawn_app,
+    assert_problem, assert_validation, close, json_body, paths_of, plan_request, small_spec,
+    spawn_app,
 };
-
-/// A plan's paths as an evaluate request's `paths`.
-fn paths_of(plan: &Value) -> Value {
-    Value::Array(
-        plan["plans"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|p| {
-                json!({
-                    "sensor": p["sensor"],
-                    "path": p["path"].as_array().unwrap().iter()
-                        .map(|c| json!({"col": c["col"], "row": c["row"]}))
-                        .collect::<Vec<_>>(),
-                })
-            })
-            .collect(),
-    )
-}
-
 fn total(v: &Value) -> f64 {
     v["expected_detections"].as_f64().unwrap()
 }
