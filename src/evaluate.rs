@@ -292,21 +292,8 @@ impl<'p> Evaluator<'p> {
     /// Runs `f` on the fleet of the request's sensors, maximising its
     /// objective.
     fn with_fleet<R>(&self, f: impl FnOnce(&Fleet) -> R) -> R {
-        let cancel = CancelToken::never();
-        let first = self.est.first_detections(self.plan.objective);
-        let mut fleet = Fleet::new(
-            &self.planner.scenario,
-            self.est.as_dyn(),
-            &self.plan.starts,
-            &self.plan.types,
-            self.plan.horizon,
-            self.plan.min_separation,
-            &cancel,
-        );
-        if let Some(first) = &first {
-            fleet = fleet.with_first_detections(first);
-        }
-        f(&fleet)
+        self.est
+            .with_fleet(&self.planner.scenario, self.plan, &CancelToken::never(), f)
     }
 
     /// The expected detections at steps 1..=T of `paths` (one per sensor,

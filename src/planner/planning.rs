@@ -159,20 +159,9 @@ impl Planner {
         let s = &self.scenario;
         let est = self.estimator(input, cancel)?;
         cancel.check()?;
-        let first = est.first_detections(input.objective);
-        let mut fleet = Fleet::new(
-            s,
-            est.as_dyn(),
-            &input.starts,
-            &input.types,
-            input.horizon,
-            input.min_separation,
-            cancel,
-        );
-        if let Some(first) = &first {
-            fleet = fleet.with_first_detections(first);
-        }
-        let result = coordinate(&fleet, input.coordination, input.joint, started)?;
+        let result = est.with_fleet(s, input, cancel, |fleet| {
+            coordinate(fleet, input.coordination, input.joint, started)
+        })?;
         let cell_out = |c: Cell| {
             let p = s.centre(c);
             CellOut {
@@ -306,13 +295,34 @@ impl Chosen<'_> {
         }
     }
 
-    /// The intrusion objective over the exact estimator, when `objective`
-    /// asks for it (a validated input never asks it of the paper's).
-    pub(crate) fn first_detections(&self, objective: Objective) -> Option<FirstDetections<'_>> {
-        match (objective, self) {
+    /// Runs `f` on the fleet of `input`'s sensors on `scenario`, with
+    /// this estimator, maximising `input`'s objective (first detections
+    /// over the exact estimator; a validated input never asks them of the
+    /// paper's).
+    pub(crate) fn with_fleet<R>(
+        &self,
+        scenario: &Scenario,
+        input: &PlanInput,
+        cancel: &CancelToken,
+        f: impl FnOnce(&Fleet) -> R,
+    ) -> R {
+        let first = match (input.objective, self) {
             (Objective::FirstDetections, Chosen::Exact(est)) => Some(FirstDetections::new(est)),
             _ => None,
+        };
+        let mut fleet = Fleet::new(
+            scenario,
+            self.as_dyn(),
+            &input.starts,
+            &input.types,
+            input.horizon,
+            input.min_separation,
+            cancel,
+        );
+        if let Some(first) = &first {
+            fleet = fleet.with_first_detections(first);
         }
+        f(&fleet)
     }
 }
 
