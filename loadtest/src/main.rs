@@ -114,6 +114,11 @@ struct WorkloadArgs {
     /// Sensors per generated request.
     #[arg(long, default_value_t = 10)]
     sensors: usize,
+    /// Sensors of the scenario's types instead, such as `drone:4,robot:6`
+    /// for `site-fleet` (the first four drones, the next six robots); sets
+    /// the number of sensors in place of `--sensors`.
+    #[arg(long, conflicts_with = "sensors")]
+    fleet: Option<String>,
     /// Steps of history per generated request.
     #[arg(long, default_value_t = 16)]
     history: usize,
@@ -155,6 +160,21 @@ impl WorkloadArgs {
         reqs
     }
 
+    /// The generated requests' fleet.
+    fn fleet(&self) -> requests::Fleet<'_> {
+        self.fleet
+            .as_deref()
+            .map_or(requests::Fleet::Default, requests::Fleet::Typed)
+    }
+
+    /// The sensors of a generated request, as the output names them.
+    fn who(&self) -> String {
+        match &self.fleet {
+            Some(fleet) => format!("fleet {fleet}"),
+            None => format!("{} sensors", self.sensors),
+        }
+    }
+
     fn workload(&self) -> Workload {
         Workload {
             sensors: self.sensors,
@@ -177,11 +197,12 @@ impl WorkloadArgs {
             None => {
                 let planner = requests::planner_for(&self.scenario)?;
                 let t = Instant::now();
-                let reqs = requests::generate(&planner, &self.workload(), self.count)?;
+                let reqs =
+                    requests::generate(&planner, &self.workload(), self.fleet(), self.count)?;
                 eprintln!(
-                    "generated {} requests ({} sensors, {} steps of history, T = {}, mean {:.1} targets) in {:.1} s",
+                    "generated {} requests ({}, {} steps of history, T = {}, mean {:.1} targets) in {:.1} s",
                     reqs.len(),
-                    self.sensors,
+                    self.who(),
                     self.history,
                     self.horizon,
                     mean_targets(&reqs),
@@ -198,12 +219,13 @@ impl WorkloadArgs {
     /// states), generated.
     fn session(&self, planner: &Planner) -> Result<(Vec<PlanRequest>, SessionWorkload)> {
         let t = Instant::now();
-        let (reqs, wl) = requests::generate_session(planner, &self.workload(), self.count)?;
+        let (reqs, wl) =
+            requests::generate_session(planner, &self.workload(), self.fleet(), self.count)?;
         eprintln!(
-            "generated a session of {} warm-up and {} timed steps ({} sensors, {} steps of history, T = {}, mean {:.1} targets) in {:.1} s",
+            "generated a session of {} warm-up and {} timed steps ({}, {} steps of history, T = {}, mean {:.1} targets) in {:.1} s",
             wl.warmup.len(),
             wl.steps.len(),
-            self.sensors,
+            self.who(),
             self.history,
             self.horizon,
             mean_targets(&reqs),

@@ -16,6 +16,8 @@ use vigil::limits::{MAX_HISTORY_STEPS, MAX_HORIZON, MAX_SENSORS};
 use vigil::planner::{PlanRequest, Planner};
 use vigil::scenario::builtins;
 
+use vigil_sim::driver::{fleet_size, fleet_types};
+
 use crate::workload::{SessionWorkload, Workload};
 
 /// The planner of the built-in scenario `id` (its statistics computed now,
@@ -35,14 +37,57 @@ pub fn planner_for(id: &str) -> Result<Planner> {
     }
 }
 
-/// `count` distinct requests of `workload` on `planner`'s scenario.
+/// Who plans: every sensor of type `default`, or a fleet of the scenario's
+/// types such as `drone:4,robot:6` (the first four drones, the next six
+/// robots).
+#[derive(Debug, Clone, Copy, Default)]
+pub enum Fleet<'a> {
+    /// `workload.sensors` sensors of type `default`.
+    #[default]
+    Default,
+    /// `NAME:COUNT,…`: its sensors replace `workload.sensors`.
+    Typed(&'a str),
+}
+
+impl Fleet<'_> {
+    /// The sensors' types on `planner`'s scenario, one per sensor.
+    fn types(self, planner: &Planner, workload: &Workload) -> Result<Vec<usize>> {
+        match self {
+            Fleet::Default => Ok(vec![0; workload.sensors]),
+            Fleet::Typed(fleet) => {
+                let n = fleet_size(fleet)
+                    .with_context(|| format!("--fleet {fleet:?}: expected NAME:COUNT,…"))?;
+                let types = fleet_types(&planner.scenario, Some(fleet), n)
+                    .map_err(|e| anyhow::anyhow!("--fleet: {e}"))?;
+                check(
+                    &Workload {
+                        sensors: n,
+                        ..workload.clone()
+                    },
+                    1,
+                )?;
+                Ok(types)
+            }
+        }
+    }
+}
+
+/// `count` distinct requests of `workload` on `planner`'s scenario, by
+/// `fleet`.
 ///
 /// # Errors
 /// If the workload is outside the API's bounds (sensors 1..=256, history
-/// ≤ 32, horizon 1..=12) or `count` is 0.
-pub fn generate(planner: &Planner, workload: &Workload, count: usize) -> Result<Vec<PlanRequest>> {
+/// ≤ 32, horizon 1..=12), `count` is 0, or the fleet does not parse or
+/// names a type the scenario lacks.
+pub fn generate(
+    planner: &Planner,
+    workload: &Workload,
+    fleet: Fleet<'_>,
+    count: usize,
+) -> Result<Vec<PlanRequest>> {
     check(workload, count)?;
-    Ok(workload.requests(planner, count))
+    let types = fleet.types(planner, workload)?;
+    Ok(workload.requests_of_fleet(planner, count, types))
 }
 
 /// The requests of [`generate`] and the session replay of the same run:
@@ -54,10 +99,12 @@ pub fn generate(planner: &Planner, workload: &Workload, count: usize) -> Result<
 pub fn generate_session(
     planner: &Planner,
     workload: &Workload,
+    fleet: Fleet<'_>,
     count: usize,
 ) -> Result<(Vec<PlanRequest>, SessionWorkload)> {
     check(workload, count)?;
-    Ok(workload.requests_and_session(planner, count))
+    let types = fleet.types(planner, workload)?;
+    Ok(workload.requests_and_session_of_fleet(planner, count, types))
 }
 
 /// The API's bounds on a generated workload.
@@ -233,15 +280,15 @@ mod tests {
             horizon: 3,
             seed: 1,
         };
-        assert!(generate(&p, &w, 1).is_err());
+        assert!(generate(&p, &w, Fleet::Default, 1).is_err());
         let w = Workload {
             sensors: 2,
             horizon: 13,
             ..w
         };
-        assert!(generate(&p, &w, 1).is_err());
+        assert!(generate(&p, &w, Fleet::Default, 1).is_err());
         let w = Workload { horizon: 2, ..w };
-        assert!(generate(&p, &w, 0).is_err());
-        assert_eq!(generate(&p, &w, 2).unwrap().len(), 2);
+        assert!(generate(&p, &w, Fleet::Default, 0).is_err());
+        assert_eq!(generate(&p, &w, Fleet::Default, 2).unwrap().len(), 2);
     }
 }

@@ -87,7 +87,21 @@ impl Workload {
         planner: &Planner,
         count: usize,
     ) -> (Vec<PlanRequest>, SessionWorkload) {
-        self.replay(planner, count, vec![0; self.sensors], true)
+        self.requests_and_session_of_fleet(planner, count, vec![0; self.sensors])
+    }
+
+    /// The same with sensors of the scenario's types `types` (one entry per
+    /// sensor; `self.sensors` is ignored).
+    ///
+    /// # Panics
+    /// As [`Workload::requests`].
+    pub fn requests_and_session_of_fleet(
+        &self,
+        planner: &Planner,
+        count: usize,
+        types: Vec<usize>,
+    ) -> (Vec<PlanRequest>, SessionWorkload) {
+        self.replay(planner, count, types, true)
     }
 
     /// The run behind [`Workload::requests_of_fleet`] and

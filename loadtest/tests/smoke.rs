@@ -56,7 +56,7 @@ fn small_requests() -> Vec<vigil::planner::PlanRequest> {
         horizon: 3,
         seed: 5,
     };
-    requests::generate(&planner, &w, 6).unwrap()
+    requests::generate(&planner, &w, requests::Fleet::Default, 6).unwrap()
 }
 
 fn config(target: Target, rate: f64, arrivals: Arrivals, duration_ms: u64) -> RunConfig {
