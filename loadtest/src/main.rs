@@ -33,6 +33,11 @@ use vigil_loadtest::session;
 use vigil_loadtest::sweep::{self, SweepConfig};
 use vigil_loadtest::workload::{SessionWorkload, Workload};
 
+/// The server's allocator, so that `inproc` times plans as the server
+/// makes them (its allocations are a few percent of a plan).
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 /// Open-loop load generator for the Vigil planning API.
 ///
 /// Without a subcommand, replays plan requests (generated from vigil-sim
