@@ -12,10 +12,12 @@
 //! - [`session`]: session mode: a session's steps replayed in process
 //!   ([`session::session_step`]), timed beside the stateless plans.
 //! - [`certify`]: the certified gap and plan time of each coordination.
+//! - [`accuracy`]: the exact estimator's error against a fine angular grid.
 //! - [`report`]: the summary of a whole `run.sh` session.
 //!
 //! The method and the figures are in the crate's `README.md`.
 
+pub mod accuracy;
 pub mod certify;
 pub mod generator;
 pub mod inproc;

@@ -71,6 +71,11 @@ impl PlanInput {
         &self.types
     }
 
+    /// The horizon T, steps.
+    pub fn horizon(&self) -> usize {
+        self.horizon
+    }
+
     /// Validates a request against a scenario.
     pub fn new(s: &Scenario, req: &PlanRequest) -> Result<Self, ValidationError> {
         if req.sensors.is_empty() {

@@ -51,6 +51,32 @@ impl Planner {
         cancel: &CancelToken,
         progress: &Progress,
     ) -> Result<Self, Cancelled> {
+        let density = SourceRays::density(&scenario);
+        Self::precompute_at(scenario, density, cancel, progress)
+    }
+
+    /// [`Planner::new`] with `rays_per_pi` rays per π in each source's
+    /// angular grid instead of the default ([`SourceRays::density`]): for
+    /// accuracy studies, whose reference is a much finer grid.
+    pub fn with_rays_per_pi(scenario: Scenario, rays_per_pi: f64) -> Self {
+        match Self::precompute_at(
+            scenario,
+            rays_per_pi,
+            &CancelToken::never(),
+            &Progress::default(),
+        ) {
+            Ok(planner) => planner,
+            Err(Cancelled) => unreachable!("a token that never cancels"),
+        }
+    }
+
+    /// [`Planner::precompute`] at `rays_per_pi`.
+    fn precompute_at(
+        scenario: Scenario,
+        rays_per_pi: f64,
+        cancel: &CancelToken,
+        progress: &Progress,
+    ) -> Result<Self, Cancelled> {
         let started = Instant::now();
         progress.add_total(scenario.fovs.len() * Stats::blocks(&scenario) + 1);
         let stats = scenario
@@ -59,7 +85,7 @@ impl Planner {
             .map(|&fov| Stats::for_fov_cancellable(&scenario, fov, cancel, progress))
             .collect::<Result<Vec<_>, _>>()?;
         cancel.check()?;
-        let mut rays = SourceRays::for_scenario(&scenario);
+        let mut rays = SourceRays::with_density(&scenario, rays_per_pi);
         let grid = ElementaryGrid::new(&scenario);
         if let Some(grid) = &grid {
             SourceRays::index_crossings(&mut rays, &scenario, grid);
@@ -229,27 +255,39 @@ impl Planner {
                 input.horizon,
             )),
             EstimatorKind::Exact => {
-                let observed = self.observed_looks(input);
-                let est = ExactEstimator::new(
-                    Precomputed {
-                        scenario: s,
-                        stats: &self.stats,
-                        rays: &self.rays,
-                        grid: self.grid.as_ref(),
-                    },
-                    Situation {
-                        observed: &observed,
-                        targets: &input.targets,
-                        starts: &input.starts,
-                        types: &input.types,
-                        horizon: input.horizon,
-                    },
-                );
+                let est = self.exact_estimator(input, None);
                 cancel.check()?;
                 est.prepare();
                 Chosen::Exact(est)
             }
         })
+    }
+
+    /// The exact estimator of `input` (whichever estimator it asks for), its
+    /// windows built on first use, on `rays` instead of the planner's own
+    /// when given: an accuracy study compares its values with those of a
+    /// finer angular grid ([`SourceRays::with_density`]).
+    pub fn exact_estimator<'a>(
+        &'a self,
+        input: &PlanInput,
+        rays: Option<&'a [SourceRays]>,
+    ) -> ExactEstimator<'a> {
+        let observed = self.observed_looks(input);
+        ExactEstimator::new(
+            Precomputed {
+                scenario: &self.scenario,
+                stats: &self.stats,
+                rays: rays.unwrap_or(&self.rays),
+                grid: self.grid.as_ref(),
+            },
+            Situation {
+                observed: &observed,
+                targets: &input.targets,
+                starts: &input.starts,
+                types: &input.types,
+                horizon: input.horizon,
+            },
+        )
     }
 
     /// `O_s` for s = 0, 1, …: the looks taken now and in the history (the
