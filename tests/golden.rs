@@ -1,12 +1,17 @@
-//! The paper's built-ins answer exactly as before the target model grew
-//! (speed mixtures and cones): the statistics of `paper-v10` and
-//! `paper-v15` (and of a circular-field-of-view variant), and the plans for
+//! The paper's built-ins answer as recorded: the statistics of `paper-v10`
+//! and `paper-v15` (and of a circular-field-of-view variant) and the ids of
+//! stored specs bit for bit (SHA-256 of their JSON), and the plans for
 //! recorded requests of a `vigil-sim` run with 16 steps of history, for
-//! every estimator and coordination, are bit for bit the ones recorded in
-//! `tests/golden/paper-builtins.json` before the change (SHA-256 of their
-//! JSON, compute time zeroed), on one, two and three threads alike and
-//! outside any pool (a one-core server plans on its async worker), and the
-//! ids of stored specs are unchanged.
+//! every estimator and coordination, on one, two and three threads alike
+//! and outside any pool (a one-core server plans on its async worker).
+//! The paper estimator's plans are bit for bit the ones recorded in
+//! `tests/golden/paper-builtins.json` (their whole response, compute time
+//! zeroed). The exact estimator's values may move when they move closer to
+//! the model (issue 34), which `loadtest/tests/accuracy.rs` checks against
+//! a fine grid; here its plans keep their paths bit for bit and their
+//! expected detections to a relative 1e-9. Only a change that moves the
+//! values records them again (`VIGIL_UPDATE_GOLDEN=1 cargo test --test
+//! golden` rewrites them, and never the others), and its commit says why.
 //! Fields added since (the minimum separation, 0 for the built-ins, and
 //! its violation counts) must be 0, and are left out of the digest, as is
 //! the certificate of exact plans (which must bound their value).
@@ -21,6 +26,17 @@ use vigil::scenario::{Scenario, ScenarioSpec, builtins};
 fn digest(v: &Value) -> String {
     let d = Sha256::digest(serde_json::to_string(v).unwrap().as_bytes());
     d.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// SHA-256 of each plan's sensor id and path, in order.
+fn paths_digest(resp: &Value) -> String {
+    let paths: Vec<Value> = resp["plans"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| json!([p["sensor"], p["path"]]))
+        .collect();
+    digest(&Value::Array(paths))
 }
 
 /// Checks that a response kept no separation rule and that an exact plan's
@@ -58,6 +74,12 @@ fn strip_added(resp: &mut Value) {
 /// many cores the replica has.
 #[test]
 fn paper_builtins_answer_exactly_as_before() {
+    if std::env::var_os("VIGIL_UPDATE_GOLDEN").is_some() {
+        // Records the exact plans' paths and values from the calling
+        // thread; the next run (built with the new file) checks them.
+        check_builtins(None);
+        return;
+    }
     for threads in [1, 2, 3] {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -73,9 +95,11 @@ fn paper_builtins_answer_exactly_as_before() {
 /// thread outside any pool.
 fn check_builtins(threads: Option<usize>) {
     let doc: Value = serde_json::from_str(include_str!("golden/paper-builtins.json")).unwrap();
+    let updating = std::env::var_os("VIGIL_UPDATE_GOLDEN").is_some() && threads.is_none();
+    let mut updated = doc.clone();
     let builtins = builtins();
     let mut checked = 0;
-    for sc in doc["scenarios"].as_array().unwrap() {
+    for (sc_index, sc) in doc["scenarios"].as_array().unwrap().iter().enumerate() {
         let id = sc["id"].as_str().unwrap();
         let scenario = match builtins.iter().find(|b| b.id == id) {
             Some(b) => b.clone(),
@@ -124,14 +148,44 @@ fn check_builtins(threads: Option<usize>) {
             let mut resp = serde_json::to_value(resp).unwrap();
             resp["compute_micros"] = json!(0);
             strip_added(&mut resp);
-            assert_eq!(
-                digest(&resp),
-                case["response_sha256"],
-                "{id}: case {i} ({}) answers differently on {threads:?} threads",
-                case["override"]
-            );
+            let what = || {
+                format!(
+                    "{id}: case {i} ({}) on {threads:?} threads",
+                    case["override"]
+                )
+            };
+            if resp["estimator"] == "exact" {
+                let (paths, value) = (paths_digest(&resp), resp["expected_detections"].clone());
+                if updating {
+                    let case = &mut updated["scenarios"][sc_index]["cases"][i];
+                    case["paths_sha256"] = json!(paths);
+                    case["expected_detections"] = value;
+                    case.as_object_mut().unwrap().remove("response_sha256");
+                    continue;
+                }
+                assert_eq!(paths, case["paths_sha256"], "{}: paths", what());
+                let (v, recorded) = (
+                    value.as_f64().unwrap(),
+                    case["expected_detections"].as_f64().unwrap(),
+                );
+                assert!(
+                    (v - recorded).abs() <= 1e-9 * recorded.abs().max(1.0),
+                    "{}: expected detections {v}, recorded {recorded}",
+                    what()
+                );
+            } else {
+                assert_eq!(digest(&resp), case["response_sha256"], "{}", what());
+            }
             checked += 1;
         }
+    }
+    if updating {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tests/golden/paper-builtins.json"
+        );
+        std::fs::write(path, serde_json::to_string(&updated).unwrap()).unwrap();
+        return;
     }
     assert!(checked >= 40, "{checked}");
     for entry in doc["ids"].as_array().unwrap() {
