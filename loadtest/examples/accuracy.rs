@@ -1,7 +1,8 @@
 #![allow(missing_docs, clippy::unwrap_used)]
 //! The exact estimator's error against 4,096 rays per π, for every
-//! built-in with the fleets it was made for, at its default grid and at
-//! the densities given as arguments (rays per π, e.g. `96 192`):
+//! built-in with the fleets it was made for, at its default grid (with
+//! the plain midpoint rule, then the area correction) and at the
+//! densities given as arguments (rays per π, e.g. `96 192`):
 //!
 //! ```text
 //! cargo run --release -p vigil-loadtest --example accuracy [-- DENSITY…]
@@ -38,10 +39,14 @@ fn main() {
         let reqs = Workload::reference().requests_of_fleet(&planner, STATES, types);
         let fine = SourceRays::with_density(&planner.scenario, REFERENCE_RAYS_PER_PI);
         let default = SourceRays::density(&planner.scenario);
-        let mut rows = vec![(default, errors(&planner, &reqs, &fine))];
+        let plain = Planner::with_rays_per_pi(planner.scenario.clone(), default).plain_midpoint();
+        let mut rows = vec![
+            (format!("{default} plain"), errors(&plain, &reqs, &fine)),
+            (format!("{default}"), errors(&planner, &reqs, &fine)),
+        ];
         for &d in &densities {
             let coarse = Planner::with_rays_per_pi(planner.scenario.clone(), d);
-            rows.push((d, errors(&coarse, &reqs, &fine)));
+            rows.push((format!("{d}"), errors(&coarse, &reqs, &fine)));
         }
         for (d, e) in rows {
             println!(

@@ -70,6 +70,14 @@ impl Planner {
         }
     }
 
+    /// This planner with the plain midpoint rule in its windows, as before
+    /// the area correction ([`SourceRays::plain_midpoint`]): for accuracy
+    /// studies that compare the two on the same states.
+    pub fn plain_midpoint(mut self) -> Self {
+        self.rays.iter_mut().for_each(SourceRays::plain_midpoint);
+        self
+    }
+
     /// [`Planner::precompute`] at `rays_per_pi`.
     fn precompute_at(
         scenario: Scenario,

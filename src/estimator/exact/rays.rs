@@ -5,7 +5,7 @@
 use rayon::prelude::*;
 
 use crate::estimator::elementary::{ElementaryGrid, Segment, trace};
-use crate::geometry::{Point, Rect, Region};
+use crate::geometry::{Point, Rect, Region, wedge_inv_r_integral};
 use crate::scenario::{Cell, FovSpec, Scenario, Source};
 use crate::stats::angular_span;
 
@@ -19,6 +19,12 @@ use crate::stats::angular_span;
 /// Carlo) at a third of the cost of 384: the measured errors per resolution
 /// are in `docs/performance.md` (*Rays per π*).
 pub const RAYS_PER_PI_SQUARE: f64 = 128.0;
+
+/// The largest share of a source's measure over the zone that may lie in
+/// rectangles no ray of it crosses for its windows to take the area
+/// correction ([`Crossings::area_correction`]); past it they keep the
+/// plain midpoint rule.
+const MAX_UNCROSSED_MEASURE: f64 = 5e-3;
 
 /// Crossings of the ray index allowed per lattice cell (about 100 bytes a
 /// cell): past it and [`MIN_INDEX_CROSSINGS`], plans walk the grid instead.
@@ -177,6 +183,11 @@ pub(super) struct Crossings {
     cells: Vec<[u32; 2]>,
     /// `cells[k]` as an index into the whole grid, `b·nx + a`.
     lin: Vec<u32>,
+    /// Per crossing, its rectangle's area correction: the rectangle's
+    /// exact measure `∫∫ dr dα` from this source (within its cone) over the
+    /// measure the rays sample there, `step · Σ` of their lengths inside it
+    /// (see [`Crossings::area_correction`]).
+    kappa: Vec<f64>,
 }
 
 impl Crossings {
@@ -189,6 +200,23 @@ impl Crossings {
             &self.cells[a..b],
             &self.lin[a..b],
         )
+    }
+
+    /// Ray `m`'s area corrections, aligned with its rectangles.
+    ///
+    /// The midpoint rule measures a rectangle's seen part as the rays'
+    /// lengths in it times the angular step. Scaled by its rectangle's
+    /// correction, each ray's length stands for its share of the
+    /// rectangle's exact measure instead: a rectangle all seen (or all
+    /// unseen) then has no quadrature error left, and a partly seen one
+    /// only that of where the seen part's edges cross it. Measured against
+    /// 4,096 rays per π, this halves the mean error of the paper's values
+    /// and divides the sites' by two to three (`docs/performance.md`,
+    /// *Accuracy*).
+    #[inline]
+    pub(super) fn area_correction(&self, m: usize) -> &[f64] {
+        let (a, b) = (self.offsets[m] as usize, self.offsets[m + 1] as usize);
+        &self.kappa[a..b]
     }
 }
 
@@ -304,11 +332,56 @@ impl SourceRays {
                 }
                 offsets.push(cells.len() as u32);
             }
+            // Each crossed rectangle's correction, from the crossings
+            // grouped by rectangle (a sort, not a table over the grid: a
+            // large lattice's grid has millions of rectangles).
+            let len: Vec<f64> = (0..n)
+                .flat_map(|m| {
+                    let (a, b) = (offsets[m] as usize, offsets[m + 1] as usize);
+                    let r = &r;
+                    (a..b).map(move |k| r[k + m + 1] - r[k + m])
+                })
+                .collect();
+            let mut order: Vec<u32> = (0..lin.len() as u32).collect();
+            order.sort_unstable_by_key(|&k| lin[k as usize]);
+            let mut kappa = vec![1.0; lin.len()];
+            let src = &sr.source;
+            let measure = |rect: &Rect| {
+                wedge_inv_r_integral(src.pos, rect, src.frame, src.cone.0, src.cone.1)
+            };
+            let mut crossed = 0.0;
+            for group in order.chunk_by(|&x, &y| lin[x as usize] == lin[y as usize]) {
+                let sampled: f64 = group.iter().map(|&k| len[k as usize]).sum::<f64>() * sr.step;
+                // A rectangle only touched (length 0) keeps the plain
+                // rule: its crossings add nothing either way.
+                if sampled > 0.0 {
+                    let [a, b] = cells[group[0] as usize];
+                    let exact = measure(&Rect {
+                        x0: grid.xs[a as usize],
+                        x1: grid.xs[a as usize + 1],
+                        y0: grid.ys[b as usize],
+                        y1: grid.ys[b as usize + 1],
+                    });
+                    crossed += exact;
+                    for &k in group {
+                        kappa[k as usize] = exact / sampled;
+                    }
+                }
+            }
+            // A rectangle no ray crosses loses its seen part whatever the
+            // rule; the plain rule makes up for it on average (its
+            // neighbours' rays run longer), the corrected one does not.
+            // Rays too sparse for the grid (a coarse `rays_per_pi`, a
+            // narrow cone far out) keep the plain rule.
+            if crossed < (1.0 - MAX_UNCROSSED_MEASURE) * measure(&zone.rect) {
+                kappa.fill(1.0);
+            }
             sr.crossings = Some(Crossings {
                 offsets,
                 r,
                 cells,
                 lin,
+                kappa,
             });
         });
     }
@@ -379,6 +452,15 @@ impl SourceRays {
         });
     }
 
+    /// These rays with the plain midpoint rule in the windows, as the
+    /// general path integrates (no [`Crossings::area_correction`]): checks
+    /// compare the two paths' values to rounding with it.
+    pub fn plain_midpoint(&mut self) {
+        if let Some(c) = &mut self.crossings {
+            c.kappa.iter_mut().for_each(|k| *k = 1.0);
+        }
+    }
+
     /// These rays as if no ray left the zone: their seen sets keep what
     /// lies past the exit (to check that leaving it out changes nothing).
     #[cfg(test)]
@@ -393,7 +475,11 @@ impl SourceRays {
     pub fn memory_bytes(&self) -> usize {
         (std::mem::size_of::<(Point, Point)>() + 8) * self.dirs.len()
             + self.crossings.as_ref().map_or(0, |c| {
-                4 * c.offsets.len() + 8 * c.r.len() + 8 * c.cells.len()
+                4 * c.offsets.len()
+                    + 8 * c.r.len()
+                    + 8 * c.cells.len()
+                    + 4 * c.lin.len()
+                    + 8 * c.kappa.len()
             })
             + self.looks.as_ref().map_or(0, |l| {
                 4 * l.first.len() + 4 * l.start.len() + 16 * l.pq.len() + 8 * l.past.len()

@@ -407,6 +407,7 @@ impl SeenRays<'_> {
                 continue;
             };
             let (rs, cells, _) = cr.of(m);
+            let kappa = cr.area_correction(m);
             let mut k = usize::MAX;
             for (i, &(p, q)) in hits.iter().enumerate().skip(from) {
                 if p >= wb {
@@ -424,7 +425,7 @@ impl SeenRays<'_> {
                     let (a, b) = (a as usize, b as usize);
                     // Rounding at the block's edge: a sliver outside is dropped.
                     if len > 0.0 && (a0..a1).contains(&a) && (b0..b1).contains(&b) {
-                        acc[(b - b0) * na + (a - a0)] += w * len;
+                        acc[(b - b0) * na + (a - a0)] += w * kappa[k] * len;
                     }
                     k += 1;
                 }
@@ -449,6 +450,7 @@ fn accumulate_whole(
 ) {
     for m in 0..rays {
         let (rs, _, lin) = cr.of(m);
+        let kappa = cr.area_correction(m);
         let hits = seen.of(m);
         if hits.is_empty() || lin.is_empty() {
             continue;
@@ -480,7 +482,7 @@ fn accumulate_whole(
                     next_crossing(rs, k, p)
                 };
                 while k < lin.len() && rs[k] < q {
-                    acc[lin[k] as usize] += w * (min(rs[k + 1], q) - max(rs[k], p));
+                    acc[lin[k] as usize] += w * kappa[k] * (min(rs[k + 1], q) - max(rs[k], p));
                     k += 1;
                 }
             }
