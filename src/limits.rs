@@ -27,6 +27,19 @@ pub const MAX_POPULATION: f64 = 1e9;
 pub const MAX_CELL_STATS: usize = 8_000_000;
 /// Longest scenario name, characters.
 pub const MAX_NAME_CHARS: usize = 200;
+/// Rays per π of the exact estimator's angular grid when a spec gives none
+/// and every field of view is a square (the fast path): the error and cost
+/// of each density are in `docs/performance.md` (*Accuracy*).
+pub const DEFAULT_RAYS_PER_PI_SQUARE: usize = 128;
+/// The same when a field of view is a circle: the general path integrates
+/// excluded areas by the same rule, whose error next to a source is
+/// several times larger.
+pub const DEFAULT_RAYS_PER_PI_CIRCLE: usize = 384;
+/// Fewest rays per π a spec may ask for.
+pub const MIN_RAYS_PER_PI: usize = 32;
+/// Most rays per π a spec may ask for (a plan's cost is about linear in
+/// them).
+pub const MAX_RAYS_PER_PI: usize = 1024;
 
 // A fleet.
 

@@ -88,6 +88,7 @@ fn scenario(rng: &mut StdRng, fast: bool, circle: bool) -> Scenario {
         sources,
         horizon: Some(3.into()),
         min_separation: None,
+        rays_per_pi: None,
     };
     Scenario::new(spec).unwrap()
 }

@@ -687,6 +687,7 @@ fn mixture_spec(fov: FovSpec) -> ScenarioSpec {
         ],
         horizon: Some(3.into()),
         min_separation: None,
+        rays_per_pi: None,
     }
 }
 

@@ -154,6 +154,7 @@ pub fn lattice(side: usize) -> Scenario {
         sources: paper_like_sources(w),
         horizon: Some(3.into()),
         min_separation: None,
+        rays_per_pi: None,
     })
     .unwrap()
 }

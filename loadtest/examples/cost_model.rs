@@ -174,6 +174,7 @@ fn lattice(side: usize, cell: f64, fov: FovSpec, k: usize) -> Scenario {
         sources,
         horizon: Some(3.into()),
         min_separation: None,
+        rays_per_pi: None,
     })
     .unwrap()
 }

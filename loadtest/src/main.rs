@@ -348,8 +348,20 @@ struct InprocArgs {
     /// Write the figures as JSON to this file.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Plan on the scenario with this `rays_per_pi` in its spec (the
+    /// accuracy knob; see docs/performance.md, Accuracy). The requests are
+    /// the same states as without it.
+    #[arg(long)]
+    rays_per_pi: Option<u32>,
     #[command(flatten)]
     workload: WorkloadArgs,
+}
+
+impl InprocArgs {
+    /// The planner to time: the scenario's, with `--rays-per-pi` if given.
+    fn planner(&self) -> Result<Planner> {
+        requests::planner_with(&self.workload.scenario, self.rays_per_pi)
+    }
 }
 
 #[derive(Debug, Args)]
@@ -437,7 +449,7 @@ fn inproc_cmd(a: &InprocArgs) -> Result<()> {
     if a.session {
         return inproc_session_cmd(a);
     }
-    let planner = requests::planner_for(&a.workload.scenario)?;
+    let planner = a.planner()?;
     let reqs = a.workload.requests(a.requests.as_deref())?;
     let pause = std::time::Duration::from_millis(a.pause_ms);
     let r = inproc::measure_paced(&planner, &reqs, a.iterations, pause)?;
@@ -508,8 +520,10 @@ fn certify_cmd(a: &CertifyArgs) -> Result<()> {
 }
 
 fn inproc_session_cmd(a: &InprocArgs) -> Result<()> {
-    let planner = Arc::new(requests::planner_for(&a.workload.scenario)?);
-    let (reqs, wl) = a.workload.session(&planner)?;
+    let (reqs, wl) = a
+        .workload
+        .session(&requests::planner_for(&a.workload.scenario)?)?;
+    let planner = Arc::new(a.planner()?);
     let r = session::measure(&planner, &wl, Some(&reqs), a.iterations)?;
     let s = &r.steps;
     println!(

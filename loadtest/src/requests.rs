@@ -14,7 +14,7 @@ use anyhow::{Context, Result, bail};
 use bytes::Bytes;
 use vigil::limits::{MAX_HISTORY_STEPS, MAX_HORIZON, MAX_SENSORS};
 use vigil::planner::{PlanRequest, Planner};
-use vigil::scenario::builtins;
+use vigil::scenario::{Scenario, builtins};
 
 use vigil_sim::driver::{fleet_size, fleet_types};
 
@@ -70,6 +70,23 @@ impl Fleet<'_> {
             }
         }
     }
+}
+
+/// The planner of the built-in scenario `id` with `rays_per_pi` set in its
+/// spec when given (a scenario of its own id then).
+///
+/// # Errors
+/// If no built-in scenario has that id, or the rays per π are out of
+/// bounds.
+pub fn planner_with(id: &str, rays_per_pi: Option<u32>) -> Result<Planner> {
+    let planner = planner_for(id)?;
+    let Some(rays) = rays_per_pi else {
+        return Ok(planner);
+    };
+    let mut spec = planner.scenario.spec.clone();
+    spec.rays_per_pi = Some((rays as usize).into());
+    let scenario = Scenario::new(spec).map_err(|e| anyhow::anyhow!("--rays-per-pi: {e}"))?;
+    Ok(Planner::new(scenario))
 }
 
 /// `count` distinct requests of `workload` on `planner`'s scenario, by

@@ -41,6 +41,7 @@ pub fn paper_spec(target_speed: f64) -> ScenarioSpec {
         ],
         horizon: Some(3.into()),
         min_separation: None,
+        rays_per_pi: None,
     }
 }
 
@@ -105,6 +106,7 @@ pub fn site_gates_spec() -> ScenarioSpec {
         ],
         horizon: Some(3.into()),
         min_separation: None,
+        rays_per_pi: None,
     }
 }
 

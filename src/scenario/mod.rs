@@ -13,7 +13,8 @@ use utoipa::ToSchema;
 
 use crate::geometry::{Disk, Point, Rect, Region};
 use crate::limits::{
-    DEFAULT_HORIZON, MAX_CELL_STATS, MAX_CELLS, MAX_NAME_CHARS, MAX_POPULATION, MAX_SOURCES,
+    DEFAULT_HORIZON, DEFAULT_RAYS_PER_PI_CIRCLE, DEFAULT_RAYS_PER_PI_SQUARE, MAX_CELL_STATS,
+    MAX_CELLS, MAX_NAME_CHARS, MAX_POPULATION, MAX_RAYS_PER_PI, MAX_SOURCES, MIN_RAYS_PER_PI,
 };
 
 mod builtins;
@@ -94,6 +95,14 @@ pub struct ScenarioSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(value_type = Option<u32>, minimum = 0)]
     pub min_separation: Option<Integer>,
+    /// Rays per π radians in each source's angular grid, over which the
+    /// exact estimator integrates (32..=1024; default 128 when every field
+    /// of view is a square, 384 otherwise). A plan's cost is about linear
+    /// in it, and the error against the model falls about as its square:
+    /// the measured figures are in `docs/performance.md` (*Accuracy*).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schema(value_type = Option<u32>)]
+    pub rays_per_pi: Option<Integer>,
 }
 
 /// A lattice cell, `col` east and `row` north.
@@ -141,6 +150,9 @@ pub struct Scenario {
     pub horizon: usize,
     /// Default minimum separation between sensors, cells (0: none).
     pub min_separation: usize,
+    /// Rays per π the spec asks for (`None`: the default for its fields of
+    /// view, [`Scenario::rays_per_pi`]).
+    rays_per_pi: Option<usize>,
 }
 
 fn finite_positive(field: &str, v: f64) -> Result<f64, ValidationError> {
@@ -262,6 +274,11 @@ impl Scenario {
             ));
         }
         let horizon = check_horizon("horizon", spec.horizon.as_ref(), DEFAULT_HORIZON)?;
+        let rays_per_pi = spec
+            .rays_per_pi
+            .as_ref()
+            .map(|r| r.check("rays_per_pi", MIN_RAYS_PER_PI..=MAX_RAYS_PER_PI))
+            .transpose()?;
         let min_separation =
             check_min_separation("min_separation", spec.min_separation.as_ref())?.unwrap_or(0);
         let canonical = ScenarioSpec {
@@ -296,6 +313,7 @@ impl Scenario {
             class_offsets,
             horizon,
             min_separation,
+            rays_per_pi,
         })
     }
 
@@ -326,7 +344,18 @@ impl Scenario {
         self.types.iter().map(|t| t.speed).max().unwrap_or(1)
     }
 
-    /// True when every type's field of view is a square.
+    /// Rays per π in each source's angular grid of the exact estimator:
+    /// the spec's, else [`DEFAULT_RAYS_PER_PI_SQUARE`] when every field of
+    /// view is a square, [`DEFAULT_RAYS_PER_PI_CIRCLE`] otherwise.
+    pub fn rays_per_pi(&self) -> usize {
+        self.rays_per_pi.unwrap_or(if self.all_square() {
+            DEFAULT_RAYS_PER_PI_SQUARE
+        } else {
+            DEFAULT_RAYS_PER_PI_CIRCLE
+        })
+    }
+
+    /// True when every sensor type's field of view is a square.
     pub fn all_square(&self) -> bool {
         self.fovs
             .iter()
@@ -518,6 +547,32 @@ mod tests {
         let mut s = paper_spec(10.0);
         s.cell_size = 0.01;
         assert_eq!(Scenario::new(s).unwrap_err().field, "cell_size");
+        for bad in [MIN_RAYS_PER_PI - 1, MAX_RAYS_PER_PI + 1] {
+            let mut s = paper_spec(10.0);
+            s.rays_per_pi = Some(bad.into());
+            assert_eq!(Scenario::new(s).unwrap_err().field, "rays_per_pi");
+        }
+    }
+
+    /// A spec's rays per π replace the default, and only a spec that gives
+    /// them gets another id (the built-ins' ids and every stored spec's
+    /// stay as they were).
+    #[test]
+    fn rays_per_pi_default_by_field_of_view_and_override() {
+        let paper = Scenario::new(paper_spec(10.0)).unwrap();
+        assert_eq!(paper.rays_per_pi(), DEFAULT_RAYS_PER_PI_SQUARE);
+        let mut spec = paper_spec(10.0);
+        spec.fov = FovSpec::Circle { radius: 30.0 };
+        assert_eq!(
+            Scenario::new(spec).unwrap().rays_per_pi(),
+            DEFAULT_RAYS_PER_PI_CIRCLE
+        );
+        let mut spec = paper_spec(10.0);
+        spec.rays_per_pi = Some(64.into());
+        let coarse = Scenario::new(spec).unwrap();
+        assert_eq!(coarse.rays_per_pi(), 64);
+        assert_ne!(coarse.id, paper.id);
+        assert_eq!(coarse.spec.rays_per_pi, Some(64.into()));
     }
 
     #[test]

@@ -327,3 +327,50 @@ async fn site_gates_is_built_in() {
     .await;
     assert_eq!(plan["plans"][0]["path"].as_array().unwrap().len(), 3);
 }
+
+/// A spec may set its rays per π, within bounds: the value is kept in the
+/// canonical spec, the scenario plans with it, and a coarser grid answers
+/// close to the default one (within the errors of both against the model).
+#[tokio::test]
+async fn rays_per_pi_is_a_bounded_setting_of_the_spec() {
+    let app = spawn_app().await;
+    for bad in [json!(16), json!(4096), json!(64.5), json!("many")] {
+        let mut spec = small_spec();
+        spec["rays_per_pi"] = bad.clone();
+        let res = app.post_json("/v1/scenarios", &spec).await;
+        let status = res.status();
+        assert!(
+            status == StatusCode::UNPROCESSABLE_ENTITY || status == StatusCode::BAD_REQUEST,
+            "{bad}: {status}"
+        );
+        let body = assert_problem(res, status, "rays_per_pi").await;
+        assert!(body["detail"].as_str().unwrap().contains("rays_per_pi"));
+    }
+    let mut values = Vec::new();
+    for rays in [None, Some(64)] {
+        let mut spec = small_spec();
+        if let Some(r) = rays {
+            spec["rays_per_pi"] = json!(r);
+        }
+        let created = json_body(
+            app.post_json("/v1/scenarios", &spec).await,
+            StatusCode::CREATED,
+        )
+        .await;
+        assert_eq!(
+            created["spec"].get("rays_per_pi").cloned(),
+            rays.map(|r| json!(r))
+        );
+        let id = created["id"].as_str().unwrap().to_owned();
+        let body = json!({"sensors": [{"id": "a", "x": 35, "y": 45}, {"id": "b", "x": 65, "y": 55}],
+                          "history": [[{"x": 45, "y": 45}, {"x": 65, "y": 45}]]});
+        let plan = json_body(
+            app.post_json(&format!("/v1/scenarios/{id}/plan"), &body)
+                .await,
+            StatusCode::OK,
+        )
+        .await;
+        values.push(plan["expected_detections"].as_f64().unwrap());
+    }
+    assert!(close(values[0], values[1], 0.05), "{values:?}");
+}

@@ -6,19 +6,13 @@ use rayon::prelude::*;
 
 use crate::estimator::elementary::{ElementaryGrid, Segment, trace};
 use crate::geometry::{Point, Rect, Region, wedge_inv_r_integral};
+use crate::limits::{DEFAULT_RAYS_PER_PI_CIRCLE, DEFAULT_RAYS_PER_PI_SQUARE};
 use crate::scenario::{Cell, FovSpec, Scenario, Source};
 use crate::stats::angular_span;
 
-/// Rays per π radians of takeoff angle in the angular grid of each source,
-/// for scenarios with square fields of view (the fast path).
-///
-/// The midpoint rule's error comes from the kinks of the integrand (corners
-/// of the fields of view); the cost of a plan is about linear in this number.
-/// 128 keeps the error against a 4,096-ray reference under the statistical
-/// error of any realistic check (`tests/model.rs` checks against Monte
-/// Carlo) at a third of the cost of 384: the measured errors per resolution
-/// are in `docs/performance.md` (*Rays per π*).
-pub const RAYS_PER_PI_SQUARE: f64 = 128.0;
+/// Rays per π of the angular grids of scenarios with square fields of view
+/// that ask for no other ([`DEFAULT_RAYS_PER_PI_SQUARE`]).
+pub const RAYS_PER_PI_SQUARE: f64 = DEFAULT_RAYS_PER_PI_SQUARE as f64;
 
 /// The largest share of a source's measure over the zone that may lie in
 /// rectangles no ray of it crosses for its windows to take the area
@@ -37,10 +31,9 @@ pub const MIN_INDEX_CROSSINGS: usize = 1 << 20;
 /// about 25 rays of 16 bytes each, so a few MB per source at most.
 pub const MAX_INDEXED_LOOKS: usize = 1 << 14;
 
-/// Rays per π for other fields of view (circles), which the general path
-/// evaluates: there the excluded areas of coordination are integrated by
-/// the same rule, whose error next to a source is several times larger.
-pub const RAYS_PER_PI: f64 = 384.0;
+/// Rays per π of the angular grids of scenarios with a circular field of
+/// view that ask for no other ([`DEFAULT_RAYS_PER_PI_CIRCLE`]).
+pub const RAYS_PER_PI: f64 = DEFAULT_RAYS_PER_PI_CIRCLE as f64;
 
 /// The fixed angular grid of one source: midpoints of `n` equal steps over
 /// the takeoff angles of its cone that reach the zone. Depends on the
@@ -222,20 +215,14 @@ impl Crossings {
 
 impl SourceRays {
     /// The grids of every source of a scenario with a non-zero rate, at
-    /// [`RAYS_PER_PI_SQUARE`] when every type's field of view is a square,
-    /// else [`RAYS_PER_PI`].
+    /// its rays per π ([`Scenario::rays_per_pi`]).
     pub fn for_scenario(s: &Scenario) -> Vec<SourceRays> {
         Self::with_density(s, Self::density(s))
     }
 
-    /// Rays per π of the grids on `s`: [`RAYS_PER_PI_SQUARE`] when every
-    /// type's field of view is a square, else [`RAYS_PER_PI`].
+    /// Rays per π of the grids on `s` ([`Scenario::rays_per_pi`]).
     pub fn density(s: &Scenario) -> f64 {
-        if s.all_square() {
-            RAYS_PER_PI_SQUARE
-        } else {
-            RAYS_PER_PI
-        }
+        s.rays_per_pi() as f64
     }
 
     /// Rays of a grid over takeoff angles `[lo, hi]` at `rays_per_pi`

@@ -8,8 +8,8 @@ use utoipa::openapi::{OpenApi, RefOr};
 
 use crate::limits::{
     MAX_BUDGET_MS, MAX_HISTORY_POSITIONS, MAX_HISTORY_STEPS, MAX_HORIZON, MAX_MIN_SEPARATION,
-    MAX_NAME_CHARS, MAX_NO_GO, MAX_SENSOR_SPEED, MAX_SENSOR_TYPES, MAX_SENSORS, MAX_SOURCES,
-    MAX_SPEED_CLASSES, MAX_TARGETS, MAX_TYPE_NAME_CHARS,
+    MAX_NAME_CHARS, MAX_NO_GO, MAX_RAYS_PER_PI, MAX_SENSOR_SPEED, MAX_SENSOR_TYPES, MAX_SENSORS,
+    MAX_SOURCES, MAX_SPEED_CLASSES, MAX_TARGETS, MAX_TYPE_NAME_CHARS, MIN_RAYS_PER_PI,
 };
 
 /// A bound on one property.
@@ -17,6 +17,8 @@ use crate::limits::{
 enum Bound {
     /// `maximum` of an integer.
     Maximum(usize),
+    /// `minimum` and `maximum` of an integer.
+    Range(usize, usize),
     /// `maxItems` of an array.
     MaxItems(usize),
     /// `maxItems` of an array of arrays, and of each of its items.
@@ -84,6 +86,11 @@ const RULES: &[(&[&str], &str, Bound)] = &[
         Bound::Maximum(MAX_HISTORY_STEPS),
     ),
     (&["ScenarioSpec"], "name", Bound::MaxLength(MAX_NAME_CHARS)),
+    (
+        &["ScenarioSpec"],
+        "rays_per_pi",
+        Bound::Range(MIN_RAYS_PER_PI, MAX_RAYS_PER_PI),
+    ),
     (&["ScenarioSpec"], "sources", Bound::MaxItems(MAX_SOURCES)),
     (&["ScenarioSpec"], "no_go", Bound::MaxItems(MAX_NO_GO)),
     (
@@ -148,6 +155,10 @@ impl Modify for Bounds {
 fn apply(schema: &mut Schema, bound: Bound) {
     match (schema, bound) {
         (Schema::Object(o), Bound::Maximum(max)) => o.maximum = Some(max.into()),
+        (Schema::Object(o), Bound::Range(min, max)) => {
+            o.minimum = Some(min.into());
+            o.maximum = Some(max.into());
+        }
         (Schema::Object(o), Bound::MaxLength(max)) => o.max_length = Some(max),
         (Schema::Array(a), Bound::MaxItems(max)) => a.max_items = Some(max),
         (Schema::Array(a), Bound::MaxItemsEach(outer, inner)) => {
