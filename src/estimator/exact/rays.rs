@@ -60,8 +60,8 @@ pub struct SourceRays {
 }
 
 /// Where the rays of a source cross the square field of view of every cell,
-/// for every field of view of the scenario (its `fovs`) that a certain type
-/// has: from the first ray that meets it to the last, each one's slab
+/// for every square field of view of the scenario (its `fovs`): from the
+/// first ray that meets it to the last, each one's slab
 /// interval ([`slab`]; `p > q` for a ray that misses), as the seen sets
 /// compute them for a look there. The looks of a plan are such fields of
 /// view, so the seen sets read their intervals here instead, to the same
@@ -107,8 +107,8 @@ impl LookCrossings {
 }
 
 /// The key of `region` in [`LookCrossings`], if it is the field of view of
-/// an indexed slot at some cell (the looks of certain sensors are; a
-/// whole-zone look is not). Checked by rebuilding that field of view: a key
+/// an indexed slot at some cell (the looks of sensors with square fields
+/// of view are; a whole-zone look is not). Checked by rebuilding that field of view: a key
 /// is only given for a region equal to the indexed one.
 pub(super) fn look_key(s: &Scenario, region: &Region) -> Option<LookKey> {
     if region.disk.is_some() {
@@ -139,13 +139,10 @@ pub(super) fn look_key(s: &Scenario, region: &Region) -> Option<LookKey> {
 }
 
 /// True when [`LookCrossings`] index the field of view `slot`: a square
-/// that a certain type looks through (only certain looks make seen sets
-/// that are unions, which read the index; the others weigh each look).
+/// (the looks of every type with a square field of view read the index,
+/// certain and uncertain alike).
 fn indexes(s: &Scenario, slot: usize) -> bool {
     matches!(s.fovs[slot], FovSpec::Square { .. })
-        && s.types
-            .iter()
-            .any(|t| t.fov_slot == slot && t.p_detect == 1.0)
 }
 
 /// The slab interval `[p, q]` of the ray from `o` with inverse direction
@@ -374,7 +371,7 @@ impl SourceRays {
     }
 
     /// Indexes where every ray crosses every cell's square field of view
-    /// of a certain type (`LookCrossings`), for scenarios of at most
+    /// (`LookCrossings`), for scenarios of at most
     /// `MAX_INDEXED_LOOKS` (16 384) such fields of view, a few MB per
     /// source; others compute them per plan (the same values, more slowly).
     pub fn index_looks(rays: &mut [SourceRays], s: &Scenario) {

@@ -50,27 +50,50 @@ impl RayHits {
         if observed.iter().all(|step| all_certain(step)) {
             Self::union(sr, observed, keys, speed)
         } else {
-            Self::weighted(sr, observed, speed)
+            Self::weighted(sr, observed, keys, speed)
         }
     }
 
     /// Seen sets of uncertain looks: every look's interval on every ray it
-    /// crosses, then per ray a sweep that cuts them into disjoint pieces
-    /// with their detection probability.
-    fn weighted(sr: &SourceRays, observed: &[Vec<Look>], speed: f64) -> Self {
+    /// crosses (read from the index when the look is indexed), then per
+    /// ray a sweep that cuts them into disjoint pieces with their detection
+    /// probability. As in a union, the intervals that start past the ray's
+    /// exit are left out: no use of a seen set looks there.
+    fn weighted(
+        sr: &SourceRays,
+        observed: &[Vec<Look>],
+        keys: &[Vec<Option<LookKey>>],
+        speed: f64,
+    ) -> Self {
         let mut buf = Vec::new();
         let o = sr.source.pos;
         let n = sr.dirs.len();
         let mut pieces: Vec<(u32, f64, f64, f64)> = Vec::new();
         for (s, looks) in observed.iter().enumerate() {
             let shift = speed * s as f64;
-            for look in looks {
+            for (i, look) in looks.iter().enumerate() {
+                let key = keys.get(s).and_then(|k| k.get(i).copied().flatten());
+                if let (Some(key), Some(table)) = (key, &sr.looks) {
+                    if table.past_exit(key, shift) {
+                        continue;
+                    }
+                    let (a, stored) = table.of(key);
+                    let rays = (a..).zip(stored.iter().zip(&sr.beyond[a..a + stored.len()]));
+                    for (m, (&(p, q), &far)) in rays {
+                        if p <= q && p + shift <= far {
+                            pieces.push((m as u32, p + shift, q + shift, look.p_detect));
+                        }
+                    }
+                    continue;
+                }
                 let Some((a, b)) = sr.range(&look.region, &mut buf) else {
                     continue;
                 };
                 for m in a..b {
                     let (d, inv) = sr.dirs[m];
-                    if let Some((p, q)) = look.region.ray(o, d, inv) {
+                    if let Some((p, q)) = look.region.ray(o, d, inv)
+                        && p + shift <= sr.beyond[m]
+                    {
                         pieces.push((m as u32, p + shift, q + shift, look.p_detect));
                     }
                 }

@@ -110,12 +110,12 @@ fn intervals_past_the_exit_change_no_value() {
 /// The seen sets built from indexed looks are the computed ones, to the
 /// bit: looks of every field of view (two sizes in `site-fleet`) at
 /// cells all over the lattice, its corners included, a whole-zone look
-/// (never indexed), every class's speed.
+/// (never indexed), every class's speed; certain looks (unions) and
+/// uncertain ones (pieces weighed by their detection probability).
 #[test]
 fn indexed_looks_give_the_computed_seen_sets() {
-    // site-fleet's types detect with 0.9 and 0.6: its seen sets never
-    // read the index, which it therefore does not build. Made certain,
-    // it has two sizes of field of view.
+    // site-fleet's types detect with 0.9 and 0.6; made certain, it is
+    // checked with unions too.
     let mut certain_fleet = site_fleet_spec();
     for ty in certain_fleet
         .sensor_types
@@ -126,10 +126,6 @@ fn indexed_looks_give_the_computed_seen_sets() {
     }
     certain_fleet.p_detect = Some(1.0);
     let mut scenarios = builtins();
-    let uncertain = scenarios.pop().expect("site-fleet");
-    let mut rays = SourceRays::for_scenario(&uncertain);
-    SourceRays::index_looks(&mut rays, &uncertain);
-    assert!(rays.iter().all(|r| r.looks.is_none()));
     scenarios.push(Scenario::new(certain_fleet).expect("valid"));
     let mut compared = 0;
     for s in scenarios {
@@ -151,54 +147,67 @@ fn indexed_looks_give_the_computed_seen_sets() {
         }
         assert_eq!(look_key(&s, &s.zone_region()), None);
         let (cols, rows) = (s.cols, s.rows);
-        let observed: Vec<Vec<Look>> = (0..7)
-            .map(|step: i32| {
-                let mut looks: Vec<Look> = (0..9)
-                    .map(|i: i32| {
-                        let c = Cell {
-                            col: (i * 7 + step * 3).rem_euclid(cols),
-                            row: (i * 5 + step * 2).rem_euclid(rows),
+        for p_detect in [1.0, 0.9] {
+            let look = |region| Look { region, p_detect };
+            let observed: Vec<Vec<Look>> = (0..7)
+                .map(|step: i32| {
+                    let mut looks: Vec<Look> = (0..9)
+                        .map(|i: i32| {
+                            let c = Cell {
+                                col: (i * 7 + step * 3).rem_euclid(cols),
+                                row: (i * 5 + step * 2).rem_euclid(rows),
+                            };
+                            let fov = s.fovs[i as usize % s.fovs.len()];
+                            look(s.fov_with(fov, s.centre(c)))
+                        })
+                        .collect();
+                    looks.push(look(
+                        s.fov_with(s.fovs[0], s.centre(Cell { col: 0, row: 0 })),
+                    ));
+                    let far = Cell {
+                        col: cols - 1,
+                        row: rows - 1,
+                    };
+                    looks.push(look(
+                        s.fov_with(*s.fovs.last().expect("a fov"), s.centre(far)),
+                    ));
+                    if step == 3 {
+                        looks.push(look(s.zone_region()));
+                    }
+                    looks
+                })
+                .collect();
+            let keys: Vec<Vec<_>> = observed
+                .iter()
+                .map(|step| step.iter().map(|l| look_key(&s, &l.region)).collect())
+                .collect();
+            assert!(keys.iter().flatten().filter(|k| k.is_some()).count() >= 7 * 11);
+            for sr in &rays {
+                for class in s.classes_of(sr.source_index) {
+                    let read = RayHits::new(sr, &observed, &keys, class.speed);
+                    let computed = RayHits::new(sr, &observed, &[], class.speed);
+                    assert_eq!(read.offsets, computed.offsets);
+                    let bits = |h: &RayHits| -> Vec<(u64, u64)> {
+                        h.hits
+                            .iter()
+                            .map(|&(p, q)| (p.to_bits(), q.to_bits()))
+                            .collect()
+                    };
+                    assert_eq!(bits(&read), bits(&computed), "{}", s.id);
+                    for m in 0..sr.dirs.len() {
+                        let detected = |h: &RayHits| {
+                            h.detected(m)
+                                .iter()
+                                .map(|d| d.to_bits())
+                                .collect::<Vec<_>>()
                         };
-                        let fov = s.fovs[i as usize % s.fovs.len()];
-                        Look::certain(s.fov_with(fov, s.centre(c)))
-                    })
-                    .collect();
-                looks.push(Look::certain(
-                    s.fov_with(s.fovs[0], s.centre(Cell { col: 0, row: 0 })),
-                ));
-                let far = Cell {
-                    col: cols - 1,
-                    row: rows - 1,
-                };
-                looks.push(Look::certain(
-                    s.fov_with(*s.fovs.last().expect("a fov"), s.centre(far)),
-                ));
-                if step == 3 {
-                    looks.push(Look::certain(s.zone_region()));
+                        assert_eq!(detected(&read), detected(&computed), "{} ray {m}", s.id);
+                    }
+                    assert_eq!(read.certain(), p_detect == 1.0);
+                    compared += read.hits.len();
                 }
-                looks
-            })
-            .collect();
-        let keys: Vec<Vec<_>> = observed
-            .iter()
-            .map(|step| step.iter().map(|l| look_key(&s, &l.region)).collect())
-            .collect();
-        assert!(keys.iter().flatten().filter(|k| k.is_some()).count() >= 7 * 11);
-        for sr in &rays {
-            for class in s.classes_of(sr.source_index) {
-                let read = RayHits::new(sr, &observed, &keys, class.speed);
-                let computed = RayHits::new(sr, &observed, &[], class.speed);
-                assert_eq!(read.offsets, computed.offsets);
-                let bits = |h: &RayHits| -> Vec<(u64, u64)> {
-                    h.hits
-                        .iter()
-                        .map(|&(p, q)| (p.to_bits(), q.to_bits()))
-                        .collect()
-                };
-                assert_eq!(bits(&read), bits(&computed), "{}", s.id);
-                compared += read.hits.len();
             }
         }
     }
-    assert!(compared > 2_000, "{compared}");
+    assert!(compared > 4_000, "{compared}");
 }
