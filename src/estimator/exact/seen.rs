@@ -9,7 +9,6 @@
 //! unreported is still in the zone with the rest of that probability.
 
 use super::rays::{LookKey, SourceRays, max, min, slab};
-use crate::geometry::detection_pieces;
 use crate::scenario::{Look, all_certain};
 
 /// What the rays of one source saw: per ray, the union of the intervals
@@ -117,22 +116,16 @@ impl RayHits {
         let mut offsets = vec![0u32; n + 1];
         let mut hits: Vec<(f64, f64)> = Vec::new();
         let mut detected: Vec<f64> = Vec::new();
-        let mut events: Vec<(f64, f64, bool)> = Vec::new();
-        let mut intervals: Vec<(f64, f64, f64)> = Vec::new();
+        let mut sweep = Sweep::default();
         let mut i = 0;
         for m in 0..n {
             let start = i;
             while i < pieces.len() && pieces[i].0 as usize == m {
                 i += 1;
             }
-            intervals.clear();
-            intervals.extend(pieces[start..i].iter().map(|&(_, p, q, pd)| (p, q, pd)));
             let first = hits.len();
-            detection_pieces(
-                &intervals,
-                f64::NEG_INFINITY,
-                f64::INFINITY,
-                &mut events,
+            sweep.run(
+                pieces[start..i].iter().map(|&(_, p, q, pd)| (p, q, pd)),
                 |a, b, seen| {
                     // A piece that continues the last one of this ray at
                     // the same probability extends it.
@@ -292,6 +285,77 @@ impl RayHits {
     #[inline]
     pub(super) fn certain(&self) -> bool {
         self.detected.is_empty()
+    }
+}
+
+/// The sweep that cuts one ray's weighted intervals into pieces of one
+/// detection probability each, as [`detection_pieces`] does: starts and
+/// ends are sorted apart, by the bits of their distance (never negative,
+/// so the bits sort as the numbers do), which is about twice as fast as
+/// sorting both together by a float comparison; at one distance the ends
+/// come first. Its buffers are kept from ray to ray.
+#[derive(Default)]
+pub(super) struct Sweep {
+    starts: Vec<(u64, f64)>,
+    ends: Vec<(u64, f64)>,
+}
+
+impl Sweep {
+    /// Calls `piece(a, b, detected)` for each piece of the union of
+    /// `intervals` (`(a, b, p)`, `0 ≤ a`), in order, `detected` being
+    /// `1 − Π (1 − p)` over the intervals that hold it.
+    pub(super) fn run(
+        &mut self,
+        intervals: impl Iterator<Item = (f64, f64, f64)>,
+        mut piece: impl FnMut(f64, f64, f64),
+    ) {
+        let key = |x: f64| (x + 0.0).to_bits();
+        self.starts.clear();
+        self.ends.clear();
+        for (a, b, p) in intervals {
+            if b > a {
+                self.starts.push((key(a), 1.0 - p));
+                self.ends.push((key(b), 1.0 - p));
+            }
+        }
+        self.starts.sort_unstable_by_key(|e| e.0);
+        self.ends.sort_unstable_by_key(|e| e.0);
+        // The miss probability of the open intervals: a count of certain
+        // ones (p = 1) and the product of 1 − p over the others, divided
+        // out again on closing (and reset when nothing is open, so
+        // rounding cannot accumulate).
+        let (mut open, mut certain, mut miss) = (0usize, 0usize, 1.0f64);
+        let mut prev = 0.0;
+        let (mut i, mut j) = (0, 0);
+        while j < self.ends.len() {
+            let opens = i < self.starts.len() && self.starts[i].0 < self.ends[j].0;
+            let (x, q) = if opens {
+                i += 1;
+                self.starts[i - 1]
+            } else {
+                j += 1;
+                self.ends[j - 1]
+            };
+            let x = f64::from_bits(x);
+            if open > 0 && x > prev {
+                piece(prev, x, if certain > 0 { 1.0 } else { 1.0 - miss });
+            }
+            prev = x;
+            match (opens, q <= 0.0) {
+                (true, true) => certain += 1,
+                (false, true) => certain -= 1,
+                (true, false) => miss *= q,
+                (false, false) => miss /= q,
+            }
+            if opens {
+                open += 1;
+            } else {
+                open -= 1;
+                if open == 0 {
+                    miss = 1.0;
+                }
+            }
+        }
     }
 }
 

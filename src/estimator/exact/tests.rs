@@ -1,7 +1,7 @@
 //! The seen sets along rays, checked against the estimator's values.
 
 use super::rays::{SourceRays, look_key};
-use super::seen::RayHits;
+use super::seen::{RayHits, Sweep};
 use super::{ExactEstimator, Precomputed, Situation};
 use crate::estimator::Estimator;
 use crate::estimator::elementary::ElementaryGrid;
@@ -210,4 +210,46 @@ fn indexed_looks_give_the_computed_seen_sets() {
         }
     }
     assert!(compared > 4_000, "{compared}");
+}
+
+/// The seen sets' sweep of weighted intervals gives the pieces of
+/// `detection_pieces`: the same ends, the same probabilities to rounding,
+/// on random intervals that share ends and overlap in many ways.
+#[test]
+fn the_sweep_cuts_the_pieces_detection_pieces_cuts() {
+    use rand::rngs::StdRng;
+    use rand::{RngExt, SeedableRng};
+    let mut rng = StdRng::seed_from_u64(3);
+    let mut sweep = Sweep::default();
+    let mut events = Vec::new();
+    let mut pieces = 0;
+    for _ in 0..2000 {
+        let n = rng.random_range(0..12);
+        let intervals: Vec<(f64, f64, f64)> = (0..n)
+            .map(|_| {
+                // Ends on a coarse grid, so that many coincide.
+                let a = f64::from(rng.random_range(0..40u32)) * 2.5;
+                let len = f64::from(rng.random_range(0..12u32)) * 2.5;
+                let p = [1.0, 0.9, 0.6, 0.3][rng.random_range(0..4)];
+                (a, a + len, p)
+            })
+            .collect();
+        let mut want = Vec::new();
+        crate::geometry::detection_pieces(
+            &intervals,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            &mut events,
+            |a, b, d| want.push((a, b, d)),
+        );
+        let mut got = Vec::new();
+        sweep.run(intervals.iter().copied(), |a, b, d| got.push((a, b, d)));
+        assert_eq!(got.len(), want.len(), "{intervals:?}");
+        for (g, w) in got.iter().zip(&want) {
+            assert_eq!((g.0, g.1), (w.0, w.1), "{intervals:?}");
+            assert!((g.2 - w.2).abs() <= 1e-12, "{intervals:?}: {g:?} {w:?}");
+        }
+        pieces += got.len();
+    }
+    assert!(pieces > 5000, "{pieces}");
 }
