@@ -409,10 +409,7 @@ pub fn detection_pieces(
     events: &mut Vec<(f64, f64, bool)>,
     mut piece: impl FnMut(f64, f64, f64),
 ) {
-    // Events (x, 1 − p, opens), swept in x order; the miss probability of
-    // the open intervals is kept as a count of certain ones (p = 1) and the
-    // product of 1 − p over the others, divided out again on closing (and
-    // reset when nothing is open, so rounding cannot accumulate).
+    // Events (x, 1 − p, opens), swept in x order.
     events.clear();
     for &(a, b, p) in intervals {
         let (a, b) = (a.max(lo), b.min(hi));
@@ -422,25 +419,72 @@ pub fn detection_pieces(
         }
     }
     events.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
-    let (mut open, mut certain, mut miss) = (0usize, 0usize, 1.0f64);
+    let mut held = OpenIntervals::default();
     let mut prev = lo;
     for &(x, q, opens) in events.iter() {
-        if open > 0 && x > prev {
-            piece(prev, x, if certain > 0 { 1.0 } else { 1.0 - miss });
+        if held.any() && x > prev {
+            piece(prev, x, held.detected());
         }
         prev = x;
+        held.toggle(opens, q);
+    }
+}
+
+/// The intervals open at a point of a sweep over weighted intervals (see
+/// [`detection_pieces`]): their miss probability, kept as a count of
+/// certain ones (`p = 1`) and the product of `1 − p` over the others,
+/// divided out again on closing and reset when nothing is open, so that
+/// rounding cannot accumulate.
+#[derive(Debug, Clone, Copy)]
+pub struct OpenIntervals {
+    open: usize,
+    certain: usize,
+    miss: f64,
+}
+
+impl Default for OpenIntervals {
+    fn default() -> Self {
+        Self {
+            open: 0,
+            certain: 0,
+            miss: 1.0,
+        }
+    }
+}
+
+impl OpenIntervals {
+    /// True when some interval is open.
+    #[inline]
+    pub fn any(&self) -> bool {
+        self.open > 0
+    }
+
+    /// `1 − Π (1 − p)` over the open intervals.
+    #[inline]
+    pub fn detected(&self) -> f64 {
+        if self.certain > 0 {
+            1.0
+        } else {
+            1.0 - self.miss
+        }
+    }
+
+    /// An interval of miss probability `q = 1 − p` opens (`opens`) or
+    /// closes; a close must match an open.
+    #[inline]
+    pub fn toggle(&mut self, opens: bool, q: f64) {
         match (opens, q <= 0.0) {
-            (true, true) => certain += 1,
-            (false, true) => certain -= 1,
-            (true, false) => miss *= q,
-            (false, false) => miss /= q,
+            (true, true) => self.certain += 1,
+            (false, true) => self.certain -= 1,
+            (true, false) => self.miss *= q,
+            (false, false) => self.miss /= q,
         }
         if opens {
-            open += 1;
+            self.open += 1;
         } else {
-            open -= 1;
-            if open == 0 {
-                miss = 1.0;
+            self.open -= 1;
+            if self.open == 0 {
+                self.miss = 1.0;
             }
         }
     }

@@ -9,6 +9,7 @@
 //! unreported is still in the zone with the rest of that probability.
 
 use super::rays::{LookKey, SourceRays, max, min, slab};
+use crate::geometry::OpenIntervals;
 use crate::scenario::{Look, all_certain};
 
 /// What the rays of one source saw: per ray, the union of the intervals
@@ -320,11 +321,7 @@ impl Sweep {
         }
         self.starts.sort_unstable_by_key(|e| e.0);
         self.ends.sort_unstable_by_key(|e| e.0);
-        // The miss probability of the open intervals: a count of certain
-        // ones (p = 1) and the product of 1 − p over the others, divided
-        // out again on closing (and reset when nothing is open, so
-        // rounding cannot accumulate).
-        let (mut open, mut certain, mut miss) = (0usize, 0usize, 1.0f64);
+        let mut held = OpenIntervals::default();
         let mut prev = 0.0;
         let (mut i, mut j) = (0, 0);
         while j < self.ends.len() {
@@ -337,24 +334,11 @@ impl Sweep {
                 self.ends[j - 1]
             };
             let x = f64::from_bits(x);
-            if open > 0 && x > prev {
-                piece(prev, x, if certain > 0 { 1.0 } else { 1.0 - miss });
+            if held.any() && x > prev {
+                piece(prev, x, held.detected());
             }
             prev = x;
-            match (opens, q <= 0.0) {
-                (true, true) => certain += 1,
-                (false, true) => certain -= 1,
-                (true, false) => miss *= q,
-                (false, false) => miss /= q,
-            }
-            if opens {
-                open += 1;
-            } else {
-                open -= 1;
-                if open == 0 {
-                    miss = 1.0;
-                }
-            }
+            held.toggle(opens, q);
         }
     }
 }
