@@ -1,0 +1,215 @@
+from http import HTTPStatus
+from typing import Any
+from urllib.parse import quote
+
+import httpx
+
+from ...client import AuthenticatedClient, Client
+from ...types import Response, UNSET
+from ... import errors
+
+from ...models.problem import Problem
+from ...models.scenario_stats import ScenarioStats
+from ...types import Unset
+
+
+def _get_kwargs(
+    id: str,
+    *,
+    type_: str | Unset = UNSET,
+) -> dict[str, Any]:
+    params: dict[str, Any] = {}
+
+    params["type"] = type_
+
+    params = {k: v for k, v in params.items() if v is not UNSET and v is not None}
+
+    _kwargs: dict[str, Any] = {
+        "method": "get",
+        "url": "/v1/scenarios/{id}/stats".format(
+            id=quote(str(id), safe=""),
+        ),
+        "params": params,
+    }
+
+    return _kwargs
+
+
+def _parse_response(
+    *, client: AuthenticatedClient | Client, response: httpx.Response
+) -> Problem | ScenarioStats | None:
+    if response.status_code == 200:
+        response_200 = ScenarioStats.from_dict(response.json())
+
+        return response_200
+
+    if response.status_code == 400:
+        response_400 = Problem.from_dict(response.json())
+
+        return response_400
+
+    if response.status_code == 401:
+        response_401 = Problem.from_dict(response.json())
+
+        return response_401
+
+    if response.status_code == 404:
+        response_404 = Problem.from_dict(response.json())
+
+        return response_404
+
+    if response.status_code == 503:
+        response_503 = Problem.from_dict(response.json())
+
+        return response_503
+
+    if response.status_code == 504:
+        response_504 = Problem.from_dict(response.json())
+
+        return response_504
+
+    if client.raise_on_unexpected_status:
+        raise errors.UnexpectedStatus(response.status_code, response.content)
+    else:
+        return None
+
+
+def _build_response(
+    *, client: AuthenticatedClient | Client, response: httpx.Response
+) -> Response[Problem | ScenarioStats]:
+    return Response(
+        status_code=HTTPStatus(response.status_code),
+        content=response.content,
+        headers=response.headers,
+        parsed=_parse_response(client=client, response=response),
+    )
+
+
+def sync_detailed(
+    id: str,
+    *,
+    client: AuthenticatedClient,
+    type_: str | Unset = UNSET,
+) -> Response[Problem | ScenarioStats]:
+    """Per-cell statistics of a scenario
+
+     The precomputed statistics of every cell, row-major (`row·cols + col`). The body has `3·cols·rows`
+    numbers: large for a fine lattice.
+
+    Args:
+        id (str):
+        type_ (str | Unset):
+
+    Raises:
+        errors.UnexpectedStatus: If the server returns an undocumented status code and Client.raise_on_unexpected_status is True.
+        httpx.TimeoutException: If the request takes longer than Client.timeout.
+
+    Returns:
+        Response[Problem | ScenarioStats]
+    """
+
+    kwargs = _get_kwargs(
+        id=id,
+        type_=type_,
+    )
+
+    response = client.get_httpx_client().request(
+        **kwargs,
+    )
+
+    return _build_response(client=client, response=response)
+
+
+def sync(
+    id: str,
+    *,
+    client: AuthenticatedClient,
+    type_: str | Unset = UNSET,
+) -> Problem | ScenarioStats | None:
+    """Per-cell statistics of a scenario
+
+     The precomputed statistics of every cell, row-major (`row·cols + col`). The body has `3·cols·rows`
+    numbers: large for a fine lattice.
+
+    Args:
+        id (str):
+        type_ (str | Unset):
+
+    Raises:
+        errors.UnexpectedStatus: If the server returns an undocumented status code and Client.raise_on_unexpected_status is True.
+        httpx.TimeoutException: If the request takes longer than Client.timeout.
+
+    Returns:
+        Problem | ScenarioStats
+    """
+
+    return sync_detailed(
+        id=id,
+        client=client,
+        type_=type_,
+    ).parsed
+
+
+async def asyncio_detailed(
+    id: str,
+    *,
+    client: AuthenticatedClient,
+    type_: str | Unset = UNSET,
+) -> Response[Problem | ScenarioStats]:
+    """Per-cell statistics of a scenario
+
+     The precomputed statistics of every cell, row-major (`row·cols + col`). The body has `3·cols·rows`
+    numbers: large for a fine lattice.
+
+    Args:
+        id (str):
+        type_ (str | Unset):
+
+    Raises:
+        errors.UnexpectedStatus: If the server returns an undocumented status code and Client.raise_on_unexpected_status is True.
+        httpx.TimeoutException: If the request takes longer than Client.timeout.
+
+    Returns:
+        Response[Problem | ScenarioStats]
+    """
+
+    kwargs = _get_kwargs(
+        id=id,
+        type_=type_,
+    )
+
+    response = await client.get_async_httpx_client().request(**kwargs)
+
+    return _build_response(client=client, response=response)
+
+
+async def asyncio(
+    id: str,
+    *,
+    client: AuthenticatedClient,
+    type_: str | Unset = UNSET,
+) -> Problem | ScenarioStats | None:
+    """Per-cell statistics of a scenario
+
+     The precomputed statistics of every cell, row-major (`row·cols + col`). The body has `3·cols·rows`
+    numbers: large for a fine lattice.
+
+    Args:
+        id (str):
+        type_ (str | Unset):
+
+    Raises:
+        errors.UnexpectedStatus: If the server returns an undocumented status code and Client.raise_on_unexpected_status is True.
+        httpx.TimeoutException: If the request takes longer than Client.timeout.
+
+    Returns:
+        Problem | ScenarioStats
+    """
+
+    return (
+        await asyncio_detailed(
+            id=id,
+            client=client,
+            type_=type_,
+        )
+    ).parsed
