@@ -19,7 +19,7 @@ import shlex
 import subprocess
 import sys
 
-FILES = ["README.md", "loadtest/README.md", "sim/README.md"]
+FILES = ["README.md", "loadtest/README.md", "sim/README.md", "clients/python/README.md"]
 START = re.compile(r"^(?:[A-Z_]+=\S*\s+)*(cargo|bash)\s")
 
 
