@@ -8,7 +8,7 @@ import re
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[3]
-PAGES = ["clients/python/README.md", "README.md"]
+PAGES = ["clients/python/README.md", "README.md", "docs/stonesoup.md"]
 
 
 def blocks(page: str) -> list[str]:
