@@ -9,18 +9,18 @@
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
-VENV="${VENV:-${CARGO_TARGET_DIR:-$root/target}/python-generate-venv}"
+GENERATOR_VENV="${GENERATOR_VENV:-${CARGO_TARGET_DIR:-$root/target}/python-generate-venv}"
 
-if ! cmp -s "$here/requirements-generate.txt" "$VENV/requirements-generate.txt" 2>/dev/null; then
-    python3 -m venv "$VENV"
-    "$VENV/bin/pip" install --quiet --disable-pip-version-check -r "$here/requirements-generate.txt"
-    cp "$here/requirements-generate.txt" "$VENV/requirements-generate.txt"
+if ! cmp -s "$here/requirements-generate.txt" "$GENERATOR_VENV/requirements-generate.txt" 2>/dev/null; then
+    python3 -m venv "$GENERATOR_VENV"
+    "$GENERATOR_VENV/bin/pip" install --quiet --disable-pip-version-check -r "$here/requirements-generate.txt"
+    cp "$here/requirements-generate.txt" "$GENERATOR_VENV/requirements-generate.txt"
 fi
 
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
 # The generator runs ruff from PATH as its post hook (no cache left behind).
-RUFF_NO_CACHE=true PATH="$VENV/bin:$PATH" openapi-python-client generate \
+RUFF_NO_CACHE=true PATH="$GENERATOR_VENV/bin:$PATH" openapi-python-client generate \
     --path "$root/openapi/openapi.json" \
     --config "$here/generator.yaml" \
     --custom-template-path "$here/templates" \

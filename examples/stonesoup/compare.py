@@ -261,7 +261,7 @@ def plot(results: list[dict], path: str, title: str) -> None:
                              squeeze=False)
     colours = {"vigil": "tab:blue", "vigil-first": "tab:purple", "greedy": "tab:orange",
                "random": "tab:gray", "bruteforce": "tab:green"}
-    for ax, n in zip(axes[0], counts):
+    for ax, n in zip(axes[0], counts, strict=True):
         for r in (r for r in results if r["platforms"] == n):
             ax.plot(range(len(r["per_step"])), r["per_step"], label=r["manager"],
                     color=colours.get(r["manager"]), linewidth=1.2)

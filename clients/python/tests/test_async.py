@@ -5,8 +5,8 @@ from __future__ import annotations
 import asyncio
 
 import pytest
-from test_client import PLAN, SPEC
 
+from test_client import PLAN, SPEC
 from vigil_client import AsyncVigil, Vigil, VigilError
 
 

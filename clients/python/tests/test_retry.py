@@ -7,8 +7,8 @@ import time
 
 import httpx
 import pytest
-from conftest import API_KEY
 
+from conftest import API_KEY
 from vigil_client import RetryTransport, Vigil, VigilError, retry_after
 
 #: A scenario of 2.56 M cells: its precomputation keeps the one precompute job busy for a while.
@@ -77,3 +77,31 @@ def test_the_transport_stops_when_the_next_wait_would_overrun() -> None:
     assert response.status_code == 503
     assert slept == [2, 2]
     assert sent == [b'{"sensors":[]}'] * 3
+
+
+def test_the_async_transport_waits_the_same_way() -> None:
+    import asyncio
+
+    from vigil_client import AsyncRetryTransport
+
+    answers = iter([503, 503, 200])
+    slept: list[float] = []
+
+    def handler(request: httpx.Request) -> httpx.Response:
+        return httpx.Response(next(answers), headers={"retry-after": "1"})
+
+    async def sleep(delay: float) -> None:
+        slept.append(delay)
+
+    async def run() -> int:
+        transport = AsyncRetryTransport(httpx.MockTransport(handler), max_wait=5, sleep=sleep)
+        async with httpx.AsyncClient(transport=transport) as client:
+            return (await client.get("http://vigil.test/v1/scenarios")).status_code
+
+    assert asyncio.run(run()) == 200
+    assert slept == [1, 1]
+
+
+def test_a_negative_bound_is_refused() -> None:
+    with pytest.raises(ValueError, match="max_wait"):
+        Vigil(max_retry_wait=-1)

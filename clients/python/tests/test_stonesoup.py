@@ -79,7 +79,7 @@ def test_every_vigil_move_is_a_legal_king_move_of_the_type(vigil, paper):
     sim = VigilGroundTruthSimulator(spec=spec, initial_time=T0, number_steps=6, seed=5)
     moved = 0
     try:
-        for now, truths in sim:
+        for now, _ in sim:
             if now > T0:
                 for p in platforms:
                     p.act(now)
@@ -176,7 +176,7 @@ def test_the_stationary_population_is_the_models(vigil, scenario):
 def test_ground_truth_paths_fly_straight_inside_the_zone(paper):
     sim = VigilGroundTruthSimulator(spec=paper, initial_time=T0, number_steps=100, seed=11)
     paths = {}
-    for now, truths in sim:
+    for _, truths in sim:
         for path in truths:
             paths[path.id] = path
             x, _, y, _ = path.state.state_vector.ravel()
