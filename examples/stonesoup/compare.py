@@ -122,6 +122,17 @@ class SeededRandomSensorManager(RandomSensorManager):
         return configs
 
 
+class OrderedBruteForceSensorManager(BruteForceSensorManager):
+    """Stone Soup's BruteForceSensorManager with the platforms in the order of
+    their ids, so that among joint moves of equal reward the same one wins in
+    every run (a set of platforms iterates in a different order in every
+    process)."""
+
+    @property
+    def actionables(self):
+        return sorted(super().actionables, key=lambda a: str(a.id))
+
+
 class IdealTracker:
     """Tracks keyed by the detected target's identity: position from the
     measurement, velocity from the ground truth; dropped after
@@ -189,7 +200,7 @@ def make_manager(name: str, platforms, args, vigil: Vigil, scenario: str):
     if name == "random":
         return SeededRandomSensorManager(seed=args.seed, **common)
     if name == "bruteforce":
-        return BruteForceSensorManager(reward_function=reward, **common)
+        return OrderedBruteForceSensorManager(reward_function=reward, **common)
     raise ValueError(f"unknown manager {name!r} (known: {', '.join(MANAGERS)})")
 
 
