@@ -149,10 +149,16 @@ class SensorType:
 
     def covers(self, centre: Sequence[float], point: Sequence[float]) -> bool:
         """True when the closed field of view centred at ``centre`` holds ``point``."""
-        dx, dy = float(point[0]) - float(centre[0]), float(point[1]) - float(centre[1])
-        if self.shape == "square":
-            return abs(dx) <= self.size and abs(dy) <= self.size
-        return dx * dx + dy * dy <= self.size * self.size
+        return _in_view(self.shape, self.size, centre, point)
+
+
+def _in_view(shape: str, size: float, centre: Sequence[float], point: Sequence[float]) -> bool:
+    """True when the closed square (half-width ``size``) or disk (radius
+    ``size``) centred at ``centre`` holds ``point``."""
+    dx, dy = float(point[0]) - float(centre[0]), float(point[1]) - float(centre[1])
+    if shape == "square":
+        return abs(dx) <= size and abs(dy) <= size
+    return dx * dx + dy * dy <= size * size
 
 
 def _fov(fov: Mapping[str, Any]) -> tuple[str, float]:
@@ -411,11 +417,7 @@ class VigilFOVSensor(SimpleSensor):
     def covers_at(self, centre: Sequence[float], point: Sequence[float]) -> bool:
         """True when the sensor standing at Stone Soup ``centre`` has ``point``
         (Stone Soup ``(x, y)``) in view."""
-        dx, dy = float(point[0]) - float(centre[0]), float(point[1]) - float(centre[1])
-        if self.shape == "square":
-            inside = abs(dx) <= self.size and abs(dy) <= self.size
-        else:
-            inside = dx * dx + dy * dy <= self.size * self.size
+        inside = _in_view(self.shape, self.size, centre, point)
         return inside and (self.vigil_map is None or self.vigil_map.in_zone(point))
 
     def is_detectable(self, state, measurement_model=None) -> bool:
@@ -654,8 +656,11 @@ class VigilSensorManager(SensorManager):
         (without recording the platforms' looks)."""
         platforms = self._platforms()
         now = self._now(platforms, timestamp)
+        return self._stateless_request([self._sensor(p) for p in platforms], tracks, now)
+
+    def _stateless_request(self, sensors: list[dict], tracks, now: datetime.datetime) -> dict:
         request = dict(self.plan_options or {})
-        request["sensors"] = [self._sensor(p) for p in platforms]
+        request["sensors"] = sensors
         request["targets"] = self.targets(tracks, now)
         history = self._history(now)
         if history:
@@ -695,12 +700,7 @@ class VigilSensorManager(SensorManager):
             body["detections"] = self.targets(tracks, now, updated_now=True)
             response = self._session.step(body)
         else:
-            request = dict(self.plan_options or {})
-            request["sensors"] = sensors
-            request["targets"] = self.targets(tracks, now)
-            history = self._history(now)
-            if history:
-                request["history"] = history
+            request = self._stateless_request(sensors, tracks, now)
             response = self.client.plan(self.scenario_id, request)
         self._remember(now, sensors)
         self.last_response = response
