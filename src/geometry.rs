@@ -592,7 +592,7 @@ pub fn wedge_inv_r_integral(o: Point, rect: &Rect, frame: Point, lo: f64, hi: f6
 
 /// The part of a convex polygon where `side(v) ≥ 0` (Sutherland–Hodgman
 /// against one half-plane).
-fn clip_half_plane(poly: &[Point], side: impl Fn(Point) -> f64) -> Vec<Point> {
+pub(crate) fn clip_half_plane(poly: &[Point], side: impl Fn(Point) -> f64) -> Vec<Point> {
     let mut out = Vec::with_capacity(poly.len() + 1);
     for i in 0..poly.len() {
         let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);

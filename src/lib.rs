@@ -4,6 +4,7 @@
 //! Sensor Surveillance System".
 //!
 //! The algorithm is plain synchronous code, layered as the paper is:
+//! - [`obstacle`]: buildings and screens: sight lines they block, flights they end;
 //! - [`scenario`]: the model (zone, lattice, sources, field of view), validated once;
 //! - [`stats`]: the offline per-cell statistics (`lambda_hat`, `escape_time`, `d_hat`);
 //! - [`estimator`]: `n̂(k,t)`, by the paper's equations or exactly;
@@ -31,6 +32,7 @@ pub mod geometry;
 pub mod http;
 pub mod limits;
 pub mod metric_names;
+pub mod obstacle;
 mod parallel;
 pub mod planner;
 pub mod scenario;
