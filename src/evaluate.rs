@@ -199,13 +199,10 @@ impl EvaluateInput {
                         ),
                     ));
                 }
-                if s.is_blocked(cell) {
+                if let Some(why) = s.blocked_for(plan.types[i], cell) {
                     return Err(ValidationError::new(
                         field(),
-                        format!(
-                            "(col {}, row {}) is in a no-go zone: no sensor may stand on it",
-                            cell.col, cell.row
-                        ),
+                        format!("(col {}, row {}) {why}", cell.col, cell.row),
                     ));
                 }
                 let from = if t == 0 { plan.starts[i] } else { cells[t - 1] };

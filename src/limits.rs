@@ -52,6 +52,16 @@ pub const MAX_SENSOR_SPEED: usize = 3;
 pub const MAX_TYPE_NAME_CHARS: usize = 32;
 /// Most no-go rectangles of a scenario.
 pub const MAX_NO_GO: usize = 256;
+/// Most obstacles (buildings and screens) of a scenario.
+pub const MAX_OBSTACLES: usize = 64;
+/// Fewest vertices of an obstacle's polygon.
+pub const MIN_OBSTACLE_VERTICES: usize = 3;
+/// Most vertices of an obstacle's polygon.
+pub const MAX_OBSTACLE_VERTICES: usize = 32;
+/// Rays per π over which the statistics of a scenario with obstacles
+/// integrate each cell's visible field of view (its closed forms no longer
+/// apply), and its check that every source's cone reaches the zone.
+pub const OBSTACLE_STATS_RAYS_PER_PI: usize = 2048;
 /// Largest minimum separation accepted, cells.
 pub const MAX_MIN_SEPARATION: usize = 16;
 

@@ -20,6 +20,13 @@
 //!   whole zone: [`wedge_inv_r_integral`]); circles use Gauss–Legendre
 //!   quadrature between the angular breakpoints.
 //!
+//! With obstacles ([`crate::obstacle`]) each integral is over the part of
+//! `F_c` the cell's sensor sees (all of it for a view that sees over them)
+//! and before a building ends a target's flight: `lambda_hat` counts the
+//! targets that reach that part, `d_hat` the stationary count inside it,
+//! and `escape_time = d_hat/lambda_hat` the expected time an entering
+//! target spends inside it (a target may enter it more than once).
+//!
 //! The per-class escape-time distribution (step 1d), which only the paper
 //! estimator reads and only at a sensor's own cell, is evaluated on demand by
 //! [`paper_statistical_part`] rather than stored for every cell.
@@ -28,7 +35,8 @@ use rayon::prelude::*;
 
 use crate::cancel::{CancelToken, Cancelled, Progress};
 use crate::geometry::{Point, Region, gauss_legendre, inv_r_integral, wedge_inv_r_integral};
-use crate::limits::MAX_HORIZON;
+use crate::limits::{MAX_HORIZON, OBSTACLE_STATS_RAYS_PER_PI};
+use crate::obstacle::Sight;
 use crate::scenario::{FovSpec, Scenario, Source};
 
 /// The statistics of every cell, row-major (`row·cols + col`).
@@ -141,17 +149,98 @@ fn cell_rates(s: &Scenario, fov: FovSpec, i: usize, buf: &mut Vec<Point>) -> (f6
     (lambda_hat, d_hat)
 }
 
+/// With obstacles, `(∫ [the ray meets the seen part] dα, ∫ |seen part| dα)`
+/// over `source`'s cone, where the seen part of a ray is its part inside
+/// `region`, before a building ends its flight, and visible through
+/// `sight` (when given). By the midpoint rule on
+/// [`OBSTACLE_STATS_RAYS_PER_PI`] rays per π over the angles that meet the
+/// region: the obstacles' edges make the integrands discontinuous in `α`,
+/// where the closed forms of [`chord_integral`] no longer apply.
+fn sighted_chords(
+    s: &Scenario,
+    source: &Source,
+    region: &Region,
+    sight: Option<&Sight>,
+    buf: &mut Vec<Point>,
+) -> (f64, f64) {
+    let Some((lo, hi)) = angular_span(source, region, buf) else {
+        return (0.0, 0.0);
+    };
+    let n = (((hi - lo) / std::f64::consts::PI) * OBSTACLE_STATS_RAYS_PER_PI as f64)
+        .ceil()
+        .max(1.0) as usize;
+    let h = (hi - lo) / n as f64;
+    let (mut hit, mut chord) = (0usize, 0.0);
+    let mut visible = Vec::new();
+    for m in 0..n {
+        let d = source.direction(lo + (m as f64 + 0.5) * h);
+        let inv = Point::new(1.0 / d.x, 1.0 / d.y);
+        let Some((a, b)) = region.ray(source.pos, d, inv) else {
+            continue;
+        };
+        let b = b.min(s.obstacles.stop(source.pos, d));
+        if b <= a {
+            continue;
+        }
+        let len = match sight {
+            None => b - a,
+            Some(sight) => {
+                visible.clear();
+                sight.visible(source.pos, d, a, b, &mut visible);
+                visible.iter().map(|(p, q)| q - p).sum()
+            }
+        };
+        if len > 0.0 {
+            hit += 1;
+            chord += len;
+        }
+    }
+    (hit as f64 * h, chord * h)
+}
+
+/// `(lambda_hat, d_hat)` of cell `i` for field of view `fov` in a scenario
+/// with obstacles: the targets that reach the part of `F_c` the cell sees
+/// (all of it when `sees_over`) before a building stops them.
+fn sighted_cell_rates(
+    s: &Scenario,
+    fov: FovSpec,
+    sees_over: bool,
+    i: usize,
+    buf: &mut Vec<Point>,
+) -> (f64, f64) {
+    let centre = s.centre(s.cell_at(i));
+    let region = s.fov_with(fov, centre);
+    let sight = if sees_over {
+        None
+    } else {
+        s.obstacles.sight(centre, &region)
+    };
+    let mut lambda_hat = 0.0;
+    let mut d_hat = 0.0;
+    for (j, src) in s.sources.iter().enumerate() {
+        if src.rate == 0.0 {
+            continue;
+        }
+        let (span, chord) = sighted_chords(s, src, &region, sight.as_ref(), buf);
+        lambda_hat += src.rate * span / src.spread;
+        for class in s.classes_of(j) {
+            d_hat += class.rate * chord / (src.spread * class.speed);
+        }
+    }
+    (lambda_hat, d_hat)
+}
+
 impl Stats {
-    /// Computes the statistics of every cell for the type `default`'s field
-    /// of view (in parallel).
+    /// Computes the statistics of every cell for the type `default`'s view
+    /// (in parallel).
     pub fn compute(s: &Scenario) -> Stats {
-        Self::for_fov(s, s.fov)
+        Self::for_slot(s, 0)
     }
 
-    /// The statistics of every cell for a sensor with field of view `fov`
-    /// (in parallel).
-    pub fn for_fov(s: &Scenario, fov: FovSpec) -> Stats {
-        match Self::for_fov_cancellable(s, fov, &CancelToken::never(), &Progress::default()) {
+    /// The statistics of every cell for the scenario's view `slot` (its
+    /// `fovs[slot]` and `sees_over[slot]`), in parallel.
+    pub fn for_slot(s: &Scenario, slot: usize) -> Stats {
+        match Self::for_slot_cancellable(s, slot, &CancelToken::never(), &Progress::default()) {
             Ok(stats) => stats,
             Err(Cancelled) => unreachable!("work that is never cancelled finishes"),
         }
@@ -163,20 +252,21 @@ impl Stats {
         s.cell_count().div_ceil(BLOCK_CELLS)
     }
 
-    /// [`Stats::for_fov`], computed in blocks of [`BLOCK_CELLS`] cells:
+    /// [`Stats::for_slot`], computed in blocks of [`BLOCK_CELLS`] cells:
     /// each block checks `cancel` before it starts and advances `progress`
     /// by one when it ends ([`Stats::blocks`] in all). Every cell's values
-    /// are computed as by [`Stats::for_fov`], so the result is the same bit
+    /// are computed as by [`Stats::for_slot`], so the result is the same bit
     /// for bit.
     ///
     /// # Errors
     /// [`Cancelled`] once `cancel` is cancelled.
-    pub fn for_fov_cancellable(
+    pub fn for_slot_cancellable(
         s: &Scenario,
-        fov: FovSpec,
+        slot: usize,
         cancel: &CancelToken,
         progress: &Progress,
     ) -> Result<Stats, Cancelled> {
+        let (fov, sees_over) = (s.fovs[slot], s.sees_over[slot]);
         let mut per_cell = vec![(0.0, 0.0); s.cell_count()];
         per_cell
             .par_chunks_mut(BLOCK_CELLS)
@@ -185,7 +275,11 @@ impl Stats {
                 cancel.check()?;
                 let first = block * BLOCK_CELLS;
                 for (k, slot) in out.iter_mut().enumerate() {
-                    *slot = cell_rates(s, fov, first + k, buf);
+                    *slot = if s.has_obstacles() {
+                        sighted_cell_rates(s, fov, sees_over, first + k, buf)
+                    } else {
+                        cell_rates(s, fov, first + k, buf)
+                    };
                 }
                 progress.advance(1);
                 Ok(())
@@ -197,7 +291,11 @@ impl Stats {
             .iter()
             .enumerate()
             .flat_map(|(j, src)| {
-                let chord = chord_integral(src, &zone, &mut buf);
+                let chord = if s.has_obstacles() {
+                    sighted_chords(s, src, &zone, None, &mut buf).1
+                } else {
+                    chord_integral(src, &zone, &mut buf)
+                };
                 s.classes_of(j)
                     .iter()
                     .map(move |class| class.rate * chord / (src.spread * class.speed))

@@ -3,7 +3,7 @@
 //! uniform takeoff angle over its cone (a half-plane for the paper's
 //! sources) and a speed drawn once from its speed distribution; targets fly
 //! straight, exist while inside the closed zone, and are gone once they
-//! leave it.
+//! leave it or once their flight enters a building's interior.
 //!
 //! Used by the Monte Carlo checks of the statistics and the estimators, and
 //! by the simulation client.
@@ -27,6 +27,11 @@ pub struct SimTarget {
     pub entered: bool,
     /// Index of its source.
     pub source: usize,
+    /// Distance flown from its source.
+    pub flown: f64,
+    /// Distance from its source at which a building ends its flight
+    /// (`+∞` when none does).
+    pub stop: f64,
 }
 
 /// The targets of a scenario at an integer time.
@@ -122,11 +127,13 @@ impl World {
                 vel: Point::new(u.x * speed, u.y * speed),
                 entered: false,
                 source: j,
+                flown: dist,
+                stop: s.obstacles.stop(src.pos, u),
             };
             self.next_id += 1;
             // A target's history is known exactly: it entered if its path
             // from the source has met the zone already.
-            t.entered = s.in_zone(pos) || has_crossed(s, src.pos, u, dist);
+            t.entered = s.in_zone(pos) || has_crossed(s, src.pos, u, dist.min(t.stop));
             if self.alive(s, &t) {
                 self.targets.push(t);
             }
@@ -134,6 +141,9 @@ impl World {
     }
 
     fn alive(&self, s: &Scenario, t: &SimTarget) -> bool {
+        if t.flown >= t.stop {
+            return false;
+        }
         if s.in_zone(t.pos) {
             return true;
         }
@@ -151,6 +161,11 @@ impl World {
         for t in &mut targets {
             let before = t.pos;
             t.pos = Point::new(t.pos.x + t.vel.x, t.pos.y + t.vel.y);
+            t.flown += t.vel.x.hypot(t.vel.y);
+            // Entering the zone counts only before the flight's end.
+            if t.flown >= t.stop {
+                continue;
+            }
             if !t.entered && (s.in_zone(t.pos) || segment_meets_zone(s, before, t.pos)) {
                 t.entered = true;
             }

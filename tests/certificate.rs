@@ -50,6 +50,7 @@ fn scenario(rng: &mut StdRng, fast: bool, circle: bool) -> Scenario {
             fov: FovSpec::Square { half_width: 25.0 },
             speed: None,
             p_detect: Some(0.6),
+            elevated: None,
         },
     )]);
     if fast {
@@ -59,6 +60,7 @@ fn scenario(rng: &mut StdRng, fast: bool, circle: bool) -> Scenario {
                 fov: FovSpec::Square { half_width: 15.0 },
                 speed: Some(2.into()),
                 p_detect: Some(1.0),
+                elevated: None,
             },
         );
     }
@@ -84,6 +86,7 @@ fn scenario(rng: &mut StdRng, fast: bool, circle: bool) -> Scenario {
             x1: 10.0 * (c0 + rng.random_range(1..=2)) as f64,
             y1: 10.0 * (r0 + 1) as f64,
         }]),
+        obstacles: None,
         target_speed: Some(10.0),
         sources,
         horizon: Some(3.into()),
@@ -93,14 +96,14 @@ fn scenario(rng: &mut StdRng, fast: bool, circle: bool) -> Scenario {
     Scenario::new(spec).unwrap()
 }
 
-/// A free cell's centre.
-fn free_point(rng: &mut StdRng, s: &Scenario) -> (f64, f64) {
+/// The centre of a cell free for type `ty`.
+fn free_point(rng: &mut StdRng, s: &Scenario, ty: usize) -> (f64, f64) {
     loop {
         let c = Cell {
             col: rng.random_range(0..s.cols),
             row: rng.random_range(0..s.rows),
         };
-        if s.is_free(c) {
+        if s.is_free(ty, c) {
             let p = s.centre(c);
             return (p.x, p.y);
         }
@@ -119,8 +122,8 @@ fn random_state(
 ) -> PlanRequest {
     let sensors = (0..n)
         .map(|i| {
-            let (x, y) = free_point(rng, s);
             let ty = names[rng.random_range(0..names.len())];
+            let (x, y) = free_point(rng, s, s.type_index(ty).unwrap_or(0));
             SensorIn {
                 id: Id::Text(format!("s{i}")),
                 x,
@@ -131,7 +134,7 @@ fn random_state(
         .collect();
     let targets = (0..rng.random_range(0..max_targets))
         .map(|_| {
-            let (x, y) = free_point(rng, s);
+            let (x, y) = free_point(rng, s, 0);
             TargetIn {
                 id: None,
                 x,
@@ -145,7 +148,7 @@ fn random_state(
         .map(|_| {
             (0..n)
                 .map(|_| {
-                    let (x, y) = free_point(rng, s);
+                    let (x, y) = free_point(rng, s, 0);
                     PositionIn::at(x, y)
                 })
                 .collect()
@@ -184,7 +187,7 @@ fn legal_paths(s: &Scenario, start: Cell, ty: usize, horizon: usize) -> Vec<Vec<
                 col: from.col + dc,
                 row: from.row + dr,
             };
-            if s.is_free(c) {
+            if s.is_free(ty, c) {
                 let mut next = path.clone();
                 next.push(c);
                 stack.push(next);
@@ -473,10 +476,10 @@ fn first_detection_search_beyond_four_steps_is_close_to_the_optimum() {
         let s = scenario(&mut rng, false, false);
         let planner = Planner::new(s);
         let s = &planner.scenario;
-        let (x, y) = free_point(&mut rng, s);
+        let (x, y) = free_point(&mut rng, s, 0);
         let history = (0..rng.random_range(0..3))
             .map(|_| {
-                let (x, y) = free_point(&mut rng, s);
+                let (x, y) = free_point(&mut rng, s, 0);
                 vec![PositionIn::at(x, y)]
             })
             .collect::<Vec<_>>();

@@ -40,6 +40,7 @@ fn fleet_spec(with_circle: bool) -> ScenarioSpec {
             fov: FovSpec::Square { half_width: 45.0 },
             speed: Some(2.into()),
             p_detect: Some(0.5),
+            elevated: None,
         },
     )]);
     if with_circle {
@@ -49,6 +50,7 @@ fn fleet_spec(with_circle: bool) -> ScenarioSpec {
                 fov: FovSpec::Circle { radius: 40.0 },
                 speed: None,
                 p_detect: Some(0.6),
+                elevated: None,
             },
         );
     }
@@ -90,7 +92,9 @@ fn run(
     worlds: usize,
     seed: u64,
 ) -> Vec<(f64, f64)> {
-    let stats: Vec<Stats> = s.fovs.iter().map(|&f| Stats::for_fov(s, f)).collect();
+    let stats: Vec<Stats> = (0..s.fovs.len())
+        .map(|slot| Stats::for_slot(s, slot))
+        .collect();
     let mut rays = SourceRays::for_scenario(s);
     let grid = ElementaryGrid::new(s);
     if let Some(g) = &grid {
@@ -405,7 +409,9 @@ fn fast_and_general_paths_agree_with_mixed_types() {
         y1: 140.0,
     }]);
     let s = Scenario::new(spec).expect("valid");
-    let stats: Vec<Stats> = s.fovs.iter().map(|&f| Stats::for_fov(&s, f)).collect();
+    let stats: Vec<Stats> = (0..s.fovs.len())
+        .map(|slot| Stats::for_slot(&s, slot))
+        .collect();
     // Dense rays, so the general path's midpoint rule on excluded areas is
     // close to the fast path's exact masking.
     let mut rays = SourceRays::with_density(&s, 1024.0);
@@ -421,7 +427,7 @@ fn fast_and_general_paths_agree_with_mixed_types() {
             .map(|_| {
                 loop {
                     let c = cell(rng.random_range(0..s.cols), rng.random_range(0..s.rows));
-                    if s.is_free(c) {
+                    if (0..s.types.len()).all(|ty| s.is_free(ty, c)) {
                         break c;
                     }
                 }
@@ -536,7 +542,7 @@ fn plans_respect_speeds_and_no_go_cells() {
             .map(|i| {
                 let c = loop {
                     let c = cell(rng.random_range(0..s.cols), rng.random_range(0..s.rows));
-                    if s.is_free(c) {
+                    if (0..s.types.len()).all(|ty| s.is_free(ty, c)) {
                         break c;
                     }
                 };
@@ -592,9 +598,9 @@ fn plans_respect_speeds_and_no_go_cells() {
             let mut at = cell(plan.start.col, plan.start.row);
             for c in &plan.path {
                 let next = cell(c.col, c.row);
-                assert!(s.is_free(next), "round {round}: {next:?} is not free");
+                assert!(s.is_free(ty, next), "round {round}: {next:?} is not free");
                 assert!(
-                    one_step(&s, at, speed).contains(&next),
+                    one_step(&s, at, ty).contains(&next),
                     "round {round}: {at:?} → {next:?} is not a legal step at speed {speed}"
                 );
                 at = next;
@@ -617,6 +623,7 @@ fn paper_estimator_scales_by_p_detect() {
             fov: spec.fov,
             speed: None,
             p_detect: Some(0.5),
+            elevated: None,
         },
     )]));
     let planner = Planner::new(Scenario::new(spec).expect("valid"));

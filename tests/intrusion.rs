@@ -54,7 +54,9 @@ struct Setting<'a> {
 /// 1..t−1 did: its expectation given the world.
 fn run(setting: &Setting) -> (Vec<(f64, f64)>, f64) {
     let s = &setting.scenario;
-    let stats: Vec<Stats> = s.fovs.iter().map(|&f| Stats::for_fov(s, f)).collect();
+    let stats: Vec<Stats> = (0..s.fovs.len())
+        .map(|slot| Stats::for_slot(s, slot))
+        .collect();
     let mut rays = SourceRays::for_scenario(s);
     let grid = ElementaryGrid::new(s);
     if let Some(g) = &grid {
@@ -189,6 +191,7 @@ fn fleet(circle: bool) -> Scenario {
             fov: FovSpec::Square { half_width: 45.0 },
             speed: Some(2.into()),
             p_detect: Some(0.5),
+            elevated: None,
         },
     )]);
     let mut spec = ScenarioSpec {

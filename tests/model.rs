@@ -659,6 +659,7 @@ fn mixture_spec(fov: FovSpec) -> ScenarioSpec {
         p_detect: None,
         sensor_types: None,
         no_go: None,
+        obstacles: None,
         target_speed: Some(8.0),
         sources: vec![
             SourceSpec {

@@ -150,6 +150,7 @@ pub fn lattice(side: usize) -> Scenario {
         p_detect: None,
         sensor_types: None,
         no_go: None,
+        obstacles: None,
         target_speed: Some(10.0),
         sources: paper_like_sources(w),
         horizon: Some(3.into()),

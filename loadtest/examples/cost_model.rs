@@ -170,6 +170,7 @@ fn lattice(side: usize, cell: f64, fov: FovSpec, k: usize) -> Scenario {
         p_detect: None,
         sensor_types: None,
         no_go: None,
+        obstacles: None,
         target_speed: Some(10.0),
         sources,
         horizon: Some(3.into()),
@@ -200,6 +201,7 @@ fn paper_with_types(fovs: &[FovSpec]) -> Scenario {
                         fov,
                         speed: None,
                         p_detect: None,
+                        elevated: None,
                     },
                 )
             })

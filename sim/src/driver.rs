@@ -84,8 +84,10 @@ pub fn default_warmup(s: &Scenario) -> usize {
 
 /// Near-square grid positions for `n` sensors: `cols = ⌈√n⌉` columns and
 /// enough rows, each sensor at the centre of its share of the zone, moved
-/// to the nearest free cell when that one is blocked ([`nearest_free`]).
-pub fn grid_starts(s: &Scenario, n: usize) -> Vec<Cell> {
+/// to the nearest cell free for its type `types[i]` when that one is
+/// blocked ([`nearest_free`]).
+pub fn grid_starts(s: &Scenario, types: &[usize]) -> Vec<Cell> {
+    let n = types.len();
     let cols = (n as f64).sqrt().ceil().max(1.0) as usize;
     let rows = n.div_ceil(cols);
     (0..n)
@@ -93,6 +95,7 @@ pub fn grid_starts(s: &Scenario, n: usize) -> Vec<Cell> {
             let (c, r) = (i % cols, i / cols);
             nearest_free(
                 s,
+                types[i],
                 s.snap(Point::new(
                     (c as f64 + 0.5) * s.width / cols as f64,
                     (r as f64 + 0.5) * s.height / rows as f64,
@@ -102,11 +105,12 @@ pub fn grid_starts(s: &Scenario, n: usize) -> Vec<Cell> {
         .collect()
 }
 
-/// `c` if it is free, else the first free cell on the nearest Chebyshev
-/// ring around it, rings scanned in the planner's tie order (by row, then
-/// column, from the south-west). `c` itself when no cell is free.
-pub fn nearest_free(s: &Scenario, c: Cell) -> Cell {
-    if s.is_free(c) {
+/// `c` if it is free for a sensor of type `ty`, else the first such free
+/// cell on the nearest Chebyshev ring around it, rings scanned in the
+/// planner's tie order (by row, then column, from the south-west). `c`
+/// itself when no cell is free.
+pub fn nearest_free(s: &Scenario, ty: usize, c: Cell) -> Cell {
+    if s.is_free(ty, c) {
         return c;
     }
     for k in 1..s.cols.max(s.rows) {
@@ -119,7 +123,7 @@ pub fn nearest_free(s: &Scenario, c: Cell) -> Cell {
                     col: c.col + dc,
                     row: c.row + dr,
                 };
-                if s.is_free(n) {
+                if s.is_free(ty, n) {
                     return n;
                 }
             }
@@ -249,22 +253,22 @@ impl Sim {
         seed: u64,
         history_len: usize,
     ) -> Self {
-        let sensors = types.len();
         let world_rng = StdRng::seed_from_u64(seed);
         let mut sensor_rng = StdRng::seed_from_u64(seed ^ 0x5e45_0125_u64.rotate_left(17));
         let detect_rng = StdRng::seed_from_u64(seed ^ 0xde7e_c7ed_u64.rotate_left(29));
         let starts = match start {
-            Start::Grid => grid_starts(&scenario, sensors),
+            Start::Grid => grid_starts(&scenario, &types),
             Start::Random => {
                 use rand::RngExt;
-                (0..sensors)
-                    .map(|_| {
+                types
+                    .iter()
+                    .map(|&ty| {
                         loop {
                             let c = Cell {
                                 col: sensor_rng.random_range(0..scenario.cols),
                                 row: sensor_rng.random_range(0..scenario.rows),
                             };
-                            if scenario.is_free(c) {
+                            if scenario.is_free(ty, c) {
                                 break c;
                             }
                         }
@@ -354,7 +358,8 @@ impl Sim {
     }
 
     /// Draws this step's detections: each sensor detects each target inside
-    /// its field of view with its type's `p_detect` (no draw when it is 1).
+    /// its field of view that it sees (no obstacle on the sight line, for a
+    /// ground type) with its type's `p_detect` (no draw when it is 1).
     fn sense(&mut self) {
         let s = &self.scenario;
         let looks: Vec<_> = self
@@ -372,7 +377,7 @@ impl Sim {
                     .iter()
                     .filter(|l| {
                         use rand::RngExt;
-                        l.region.contains(t.pos)
+                        s.detects(l, t.pos)
                             && (l.p_detect >= 1.0 || rng.random::<f64>() < l.p_detect)
                     })
                     .count();
@@ -589,7 +594,7 @@ impl Sim {
                 self.sensors
                     .iter()
                     .zip(&self.types)
-                    .map(|(&c, &ty)| random_move(s, c, s.types[ty].speed, rng))
+                    .map(|(&c, &ty)| random_move(s, c, ty, rng))
                     .collect()
             }
             Policy::LocalForce => {
@@ -627,8 +632,7 @@ impl Sim {
                     col: first.col,
                     row: first.row,
                 };
-                let speed = self.scenario.types[ty].speed;
-                let legal = legal_moves(&self.scenario, c, speed).contains(&next);
+                let legal = legal_moves(&self.scenario, c, ty).contains(&next);
                 legal
                     .then_some(next)
                     .ok_or_else(|| format!("illegal move {c:?} → {next:?}"))
@@ -697,6 +701,8 @@ mod tests {
             vel: Point::new(vx, vy),
             entered: s.in_zone(pos),
             source: 0,
+            flown: 0.0,
+            stop: f64::INFINITY,
         }
     }
 

@@ -127,7 +127,8 @@ impl fmt::Display for Policy {
 /// `speed` king moves through free cells (on the lattice, not blocked), in
 /// the planner's tie order ([`step_displacements`]: stay first). At speed 1
 /// on an open lattice these are the nine of [`MOVES`] that stay on it.
-pub fn legal_moves(s: &Scenario, c: Cell, speed: usize) -> Vec<Cell> {
+pub fn legal_moves(s: &Scenario, c: Cell, ty: usize) -> Vec<Cell> {
+    let speed = s.types[ty].speed;
     let m = speed as i32;
     let w = (2 * m + 1) as usize;
     let at = |dc: i32, dr: i32| ((dr + m) as usize) * w + (dc + m) as usize;
@@ -144,7 +145,7 @@ pub fn legal_moves(s: &Scenario, c: Cell, speed: usize) -> Vec<Cell> {
                     col: c.col + nc,
                     row: c.row + nr,
                 };
-                if nc.abs() <= m && nr.abs() <= m && !reach[at(nc, nr)] && s.is_free(cell) {
+                if nc.abs() <= m && nr.abs() <= m && !reach[at(nc, nr)] && s.is_free(ty, cell) {
                     reach[at(nc, nr)] = true;
                     next.push((nc, nr));
                 }
@@ -163,8 +164,8 @@ pub fn legal_moves(s: &Scenario, c: Cell, speed: usize) -> Vec<Cell> {
 }
 
 /// A uniform legal move of a sensor of speed `speed`.
-pub fn random_move(s: &Scenario, c: Cell, speed: usize, rng: &mut impl rand::Rng) -> Cell {
-    let moves = legal_moves(s, c, speed);
+pub fn random_move(s: &Scenario, c: Cell, ty: usize, rng: &mut impl rand::Rng) -> Cell {
+    let moves = legal_moves(s, c, ty);
     moves[rng.random_range(0..moves.len())]
 }
 
@@ -213,7 +214,7 @@ pub fn keep_apart(
                 dc * dc + dr * dr
             };
             let mut best: Option<(i64, Cell)> = None;
-            for c in legal_moves(s, here, s.types[ty].speed) {
+            for c in legal_moves(s, here, ty) {
                 if allowed(c) && best.is_none_or(|(b, _)| dist2(c) < b) {
                     best = Some((dist2(c), c));
                 }
@@ -300,7 +301,7 @@ pub fn local_force_move(
     }
     let mut best = here;
     let mut best_score = 0.0;
-    for n in legal_moves(s, here, ty.speed) {
+    for n in legal_moves(s, here, types[me]) {
         let (dc, dr) = ((n.col - here.col) as f64, (n.row - here.row) as f64);
         let len = dc.hypot(dr);
         if len == 0.0 {

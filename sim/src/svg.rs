@@ -1,10 +1,13 @@
 //! A picture of one run, like the paper's Figure 3: the zone over a heat map
-//! of `d_hat`, the no-go zones (grey, hatched), the sources, every sensor's
-//! trace and final position with its own type's field of view (one marker
-//! per type: a disk for `default`, then a square, a triangle, …, named in a
-//! legend), and the targets at the last step.
+//! of `d_hat`, the no-go zones (grey, hatched), the buildings (dark) and
+//! screens (green), the sources, every sensor's trace and final position
+//! with its own type's field of view (one marker per type: a disk for
+//! `default`, then a square, a triangle, …, named in a legend; with
+//! obstacles, the part of it the sensor sees, shaded), and the targets at
+//! the last step.
 
 use plotters::prelude::*;
+use vigil::obstacle::ObstacleKind;
 use vigil::stats::Stats;
 
 use crate::driver::Sim;
@@ -66,6 +69,14 @@ pub fn draw(sim: &Sim, path: &std::path::Path) -> Result<(), String> {
         root.draw(&Rectangle::new([a, b], grey.stroke_width(1)))
             .map_err(err)?;
     }
+    for ob in s.obstacles.list() {
+        let points: Vec<(i32, i32)> = ob.polygon.vertices().iter().map(|v| px(v.x, v.y)).collect();
+        let fill = match ob.kind {
+            ObstacleKind::Building => RGBColor(90, 90, 100).filled(),
+            ObstacleKind::Screen => RGBColor(120, 180, 110).mix(0.7).filled(),
+        };
+        root.draw(&Polygon::new(points, fill)).map_err(err)?;
+    }
     root.draw(&Rectangle::new(
         [px(0.0, s.height), px(s.width, 0.0)],
         BLACK.stroke_width(2),
@@ -93,7 +104,18 @@ pub fn draw(sim: &Sim, path: &std::path::Path) -> Result<(), String> {
             .map_err(err)?;
         if let Some(&last) = trace.last() {
             let ty = sim.types[i];
-            let region = s.fov_region_of(ty, last);
+            let look = s.look(ty, last);
+            if look.from.is_some() {
+                // What the sensor sees of its field of view, shaded.
+                let seen: Vec<(i32, i32)> = s
+                    .view_outline(&look, 180)
+                    .iter()
+                    .map(|q| px(q.x, q.y))
+                    .collect();
+                root.draw(&Polygon::new(seen, color.mix(0.25).filled()))
+                    .map_err(err)?;
+            }
+            let region = look.region;
             match region.disk {
                 Some(d) => root.draw(&Circle::new(
                     px(d.c.x, d.c.y),

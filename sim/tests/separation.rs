@@ -68,7 +68,7 @@ fn keep_apart_takes_the_nearest_allowed_neighbour() {
     assert_eq!(out, vec![at(10, 10), at(12, 11)]);
     // A tie: from (11, 11) toward (10, 10), (12, 10) and (10, 12) are both
     // √4 away; the first in `legal_moves`' order wins.
-    let moves = legal_moves(&s, at(11, 11), 1);
+    let moves = legal_moves(&s, at(11, 11), 0);
     let pos = |c| moves.iter().position(|&m| m == c).expect("a legal move");
     assert!(pos(at(12, 10)) < pos(at(10, 12)));
     let out = keep_apart(
@@ -141,10 +141,10 @@ fn keep_apart_keeps_the_rule_wherever_it_can() {
         // often bites.
         let current: Vec<Cell> = types
             .iter()
-            .map(|_| {
+            .map(|&ty| {
                 loop {
                     let c = at(rng.random_range(8..30), rng.random_range(4..24));
-                    if s.is_free(c) {
+                    if s.is_free(ty, c) {
                         break c;
                     }
                 }
@@ -153,14 +153,14 @@ fn keep_apart_keeps_the_rule_wherever_it_can() {
         let intended: Vec<Cell> = current
             .iter()
             .zip(&types)
-            .map(|(&c, &ty)| random_move(&s, c, s.types[ty].speed, &mut rng))
+            .map(|(&c, &ty)| random_move(&s, c, ty, &mut rng))
             .collect();
         let d = rng.random_range(1..=4);
         let out = keep_apart(&s, &current, &intended, &types, d);
         for i in 0..out.len() {
             let before = &out[..i];
             let allowed = |c: Cell| before.iter().all(|&o| !too_close(c, o, d));
-            let legal = legal_moves(&s, current[i], s.types[types[i]].speed);
+            let legal = legal_moves(&s, current[i], types[i]);
             assert!(out[i] == intended[i] || legal.contains(&out[i]));
             if allowed(intended[i]) {
                 assert_eq!(out[i], intended[i]);
@@ -231,7 +231,7 @@ fn random_sensors_at_separation_one_never_share_a_cell() {
     // Every move is still a legal king move.
     for t in &apart.trace {
         for w in t.windows(2) {
-            assert!(legal_moves(&s, w[0], 1).contains(&w[1]), "{w:?}");
+            assert!(legal_moves(&s, w[0], 0).contains(&w[1]), "{w:?}");
         }
     }
 }
@@ -253,7 +253,7 @@ fn random_sensors_without_separation_move_as_drawn() {
         let next = sim.local_moves(Policy::Random);
         cells = cells
             .iter()
-            .map(|&c| random_move(&s, c, 1, &mut rng))
+            .map(|&c| random_move(&s, c, 0, &mut rng))
             .collect();
         assert_eq!(next, cells);
         let mut distinct = cells.clone();
@@ -305,8 +305,7 @@ fn breaches(sim: &Sim, d: usize) -> (Vec<(usize, usize, usize)>, usize) {
             if near.is_empty() {
                 continue;
             }
-            let speed = sim.scenario.types[sim.types[i]].speed;
-            let escape = legal_moves(&sim.scenario, sim.trace[i][k - 1], speed)
+            let escape = legal_moves(&sim.scenario, sim.trace[i][k - 1], sim.types[i])
                 .into_iter()
                 .any(|c| earlier.iter().all(|&e| !too_close(c, e, d)));
             avoidable += usize::from(escape);

@@ -316,7 +316,8 @@ fn entries_hold_together_over_runs() {
 
 /// Within `speed` king moves of `from` through free cells? An independent
 /// breadth-first search.
-fn legal_step(s: &vigil::scenario::Scenario, from: Cell, to: Cell, speed: usize) -> bool {
+fn legal_step(s: &vigil::scenario::Scenario, from: Cell, to: Cell, ty: usize) -> bool {
+    let speed = s.types[ty].speed;
     let mut seen = std::collections::HashSet::from([from]);
     let mut frontier = vec![from];
     for _ in 0..speed {
@@ -328,7 +329,7 @@ fn legal_step(s: &vigil::scenario::Scenario, from: Cell, to: Cell, speed: usize)
                         col: c.col + dc,
                         row: c.row + dr,
                     };
-                    if s.is_free(n) && seen.insert(n) {
+                    if s.is_free(ty, n) && seen.insert(n) {
                         next.push(n);
                     }
                 }
@@ -336,20 +337,20 @@ fn legal_step(s: &vigil::scenario::Scenario, from: Cell, to: Cell, speed: usize)
         }
         frontier = next;
     }
-    s.is_free(to) && seen.contains(&to)
+    s.is_free(ty, to) && seen.contains(&to)
 }
 
 fn assert_fleet_legal(sim: &Sim) {
     for (trace, &ty) in sim.trace.iter().zip(&sim.types) {
         let speed = sim.scenario.types[ty].speed;
         assert!(
-            sim.scenario.is_free(trace[0]),
+            sim.scenario.is_free(ty, trace[0]),
             "start {:?} blocked",
             trace[0]
         );
         for w in trace.windows(2) {
             assert!(
-                legal_step(&sim.scenario, w[0], w[1], speed),
+                legal_step(&sim.scenario, w[0], w[1], ty),
                 "{:?} → {:?} at speed {speed}",
                 w[0],
                 w[1]
@@ -448,6 +449,7 @@ fn certain_fleets_count_exactly_as_default_sensors() {
             fov: spec.fov,
             speed: None,
             p_detect: None,
+            elevated: None,
         },
     )]));
     let s = vigil::scenario::Scenario::new(spec).expect("valid");

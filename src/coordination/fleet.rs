@@ -350,10 +350,13 @@ impl Fleet<'_> {
 /// steps.
 pub fn sensor_motion(scenario: &Scenario, start: Cell, ty: usize, horizon: usize) -> ValueGrid {
     ValueGrid::with_motion(horizon, scenario.types[ty].speed, |dc, dr| {
-        scenario.is_free(Cell {
-            col: start.col + dc,
-            row: start.row + dr,
-        })
+        scenario.is_free(
+            ty,
+            Cell {
+                col: start.col + dc,
+                row: start.row + dr,
+            },
+        )
     })
 }
 

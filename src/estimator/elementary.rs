@@ -205,8 +205,13 @@ impl ElementaryGrid {
     /// The grid of a scenario whose sensor types all have square fields of
     /// view (the breakpoints of every size); `None` when one is a circle, or
     /// when several sizes on a large lattice would make it larger than one
-    /// size can (then every value takes the general path).
+    /// size can (then every value takes the general path), and with
+    /// obstacles, whose fields of view are not unions of rectangles once
+    /// sight lines are blocked.
     pub fn new(s: &Scenario) -> Option<Self> {
+        if s.has_obstacles() {
+            return None;
+        }
         let halves = s
             .fovs
             .iter()
@@ -425,6 +430,7 @@ mod tests {
                                 fov: FovSpec::Square { half_width: h },
                                 speed: None,
                                 p_detect: None,
+                                elevated: None,
                             },
                         )
                     })

@@ -22,7 +22,7 @@ use crate::catalog::{
     Entry, JobStatus, Listed, entry_id, precompute_cancellable, predicted_precompute_ms,
 };
 use crate::planner::Planner;
-use crate::scenario::{DEFAULT_TYPE, Scenario, ScenarioSpec};
+use crate::scenario::{DEFAULT_TYPE, ObstacleSpec, Scenario, ScenarioSpec};
 
 /// Size of a scenario's lattice.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
@@ -176,6 +176,12 @@ pub struct ScenarioStats<'a> {
     pub escape_time: &'a [f64],
     /// Stationary expected number of targets in each cell's field of view.
     pub d_hat: &'a [f64],
+    /// The scenario's obstacles (absent when it has none), to draw over
+    /// the statistics: with obstacles, each cell's statistics count only
+    /// the part of its field of view it sees (all of it for an elevated
+    /// type) and the targets no building has stopped.
+    #[serde(skip_serializing_if = "<[_]>::is_empty")]
+    pub obstacles: &'a [ObstacleSpec],
 }
 
 impl<'a> ScenarioStats<'a> {
@@ -190,6 +196,7 @@ impl<'a> ScenarioStats<'a> {
             lambda_hat: &stats.lambda_hat,
             escape_time: &stats.escape_time,
             d_hat: &stats.d_hat,
+            obstacles: p.scenario.spec.obstacles.as_deref().unwrap_or(&[]),
         }
     }
 }

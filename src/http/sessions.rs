@@ -21,7 +21,7 @@ use super::middleware::RequestStart;
 use super::planning::{plan_admitted, resolve_scenario};
 use super::state::AppState;
 use crate::limits::{MAX_HORIZON, MAX_MIN_SEPARATION, MAX_TARGETS};
-use crate::planner::PlanResponse;
+use crate::planner::{PlanResponse, check_estimator};
 use crate::scenario::ValidationError;
 use crate::session::{Session, SessionSettings, StepRequest, Track};
 
@@ -122,6 +122,11 @@ pub async fn create(
         d.check("min_separation", 0..=MAX_MIN_SEPARATION)?;
     }
     let planner = resolve_scenario(&state, start, scenario_id, inline).await?;
+    check_estimator(
+        "estimator",
+        settings.estimator.unwrap_or_default(),
+        &planner.scenario,
+    )?;
     let session = Session::new(planner, settings);
     let (id, shared) = state.sessions.insert(session);
     let info = SessionInfo::of(id.clone(), &*shared.lock().await);

@@ -60,6 +60,23 @@ pub(crate) fn check_objective(
     Ok(objective)
 }
 
+/// The estimator asked for, refused for `paper` in a scenario with
+/// obstacles: eqs. (1)–(2) have no notion of a blocked sight line or of a
+/// flight that a building ends.
+pub(crate) fn check_estimator(
+    field: &str,
+    estimator: EstimatorKind,
+    scenario: &Scenario,
+) -> Result<EstimatorKind, ValidationError> {
+    if estimator == EstimatorKind::Paper && scenario.has_obstacles() {
+        return Err(ValidationError::new(
+            field,
+            "the paper estimator has no notion of sight lines that obstacles block: this scenario has obstacles, so use the exact estimator",
+        ));
+    }
+    Ok(estimator)
+}
+
 impl PlanInput {
     /// The sensors' cells now, in request order.
     pub fn starts(&self) -> &[Cell] {
@@ -134,18 +151,12 @@ impl PlanInput {
                 )
             })
         };
-        let free = |field: &dyn Fn() -> String, c: Cell| {
-            if s.is_blocked(c) {
-                Err(ValidationError::new(
-                    field(),
-                    format!(
-                        "cell (col {}, row {}) is in a no-go zone: no sensor may stand on it",
-                        c.col, c.row
-                    ),
-                ))
-            } else {
-                Ok(c)
-            }
+        let free = |field: &dyn Fn() -> String, c: Cell, ty: usize| match s.blocked_for(ty, c) {
+            Some(why) => Err(ValidationError::new(
+                field(),
+                format!("cell (col {}, row {}) {why}", c.col, c.row),
+            )),
+            None => Ok(c),
         };
         let mut seen = HashSet::new();
         let mut ids = Vec::with_capacity(req.sensors.len());
@@ -159,8 +170,9 @@ impl PlanInput {
                 ));
             }
             let field = || format!("sensors[{i}]");
-            types.push(type_of(&field, sensor.sensor_type.as_deref())?);
-            starts.push(free(&field, in_zone(&field, sensor.x, sensor.y)?)?);
+            let ty = type_of(&field, sensor.sensor_type.as_deref())?;
+            types.push(ty);
+            starts.push(free(&field, in_zone(&field, sensor.x, sensor.y)?, ty)?);
             ids.push(sensor.id.clone());
         }
         let mut targets = Vec::with_capacity(req.targets.len());
@@ -190,7 +202,7 @@ impl PlanInput {
                     .map(|(pi, p)| {
                         let field = || format!("history[{si}][{pi}]");
                         let ty = type_of(&field, p.sensor_type.as_deref())?;
-                        Ok((free(&field, in_zone(&field, p.x, p.y)?)?, ty))
+                        Ok((free(&field, in_zone(&field, p.x, p.y)?, ty)?, ty))
                     })
                     .collect::<Result<Vec<_>, ValidationError>>()?,
             );
@@ -212,7 +224,7 @@ impl PlanInput {
             let ms = b.check("budget_ms", 1..=MAX_BUDGET_MS as usize)?;
             joint.budget = std::time::Duration::from_millis(ms as u64);
         }
-        let estimator = req.estimator.unwrap_or_default();
+        let estimator = check_estimator("estimator", req.estimator.unwrap_or_default(), s)?;
         let objective = check_objective("objective", req.objective, estimator)?;
         Ok(PlanInput {
             min_separation,

@@ -87,10 +87,8 @@ impl Planner {
     ) -> Result<Self, Cancelled> {
         let started = Instant::now();
         progress.add_total(scenario.fovs.len() * Stats::blocks(&scenario) + 1);
-        let stats = scenario
-            .fovs
-            .iter()
-            .map(|&fov| Stats::for_fov_cancellable(&scenario, fov, cancel, progress))
+        let stats = (0..scenario.fovs.len())
+            .map(|slot| Stats::for_slot_cancellable(&scenario, slot, cancel, progress))
             .collect::<Result<Vec<_>, _>>()?;
         cancel.check()?;
         let mut rays = SourceRays::with_density(&scenario, rays_per_pi);

@@ -1,16 +1,22 @@
 //! The built-in scenarios: the paper's setting at two target speeds, and
-//! two sites of our own (targets from directed gates; a mixed fleet around
-//! no-go ground).
+//! three sites of our own (targets from directed gates; a mixed fleet
+//! around no-go ground; the gated site among buildings and screens).
 
 use std::collections::BTreeMap;
 
 use super::{
-    FovSpec, Heading, NoGoSpec, Scenario, ScenarioSpec, SensorTypeSpec, SourceSpec, SpeedSpec,
-    ZoneSpec,
+    FovSpec, Heading, NoGoSpec, ObstacleSpec, Scenario, ScenarioSpec, SensorTypeSpec, SourceSpec,
+    SpeedSpec, ZoneSpec,
 };
 
 /// Names of the built-in scenarios.
-pub const BUILTIN_IDS: [&str; 4] = ["paper-v10", "paper-v15", "site-gates", "site-fleet"];
+pub const BUILTIN_IDS: [&str; 5] = [
+    "paper-v10",
+    "paper-v15",
+    "site-gates",
+    "site-fleet",
+    "site-campus",
+];
 
 /// The paper's setting: a 300×300 zone, 10-unit cells, square FOV of half
 /// width 30, eight sources of rate 0.3 at a third and two thirds of each edge.
@@ -28,6 +34,7 @@ pub fn paper_spec(target_speed: f64) -> ScenarioSpec {
         p_detect: None,
         sensor_types: None,
         no_go: None,
+        obstacles: None,
         target_speed: Some(target_speed),
         sources: vec![
             src(-1.0, 100.0),
@@ -83,6 +90,7 @@ pub fn site_gates_spec() -> ScenarioSpec {
         p_detect: None,
         sensor_types: None,
         no_go: None,
+        obstacles: None,
         target_speed: None,
         sources: vec![
             SourceSpec {
@@ -117,6 +125,7 @@ pub fn site_robot() -> SensorTypeSpec {
         fov: FovSpec::Square { half_width: 30.0 },
         speed: None,
         p_detect: Some(0.9),
+        elevated: None,
     }
 }
 
@@ -128,6 +137,7 @@ pub fn site_drone() -> SensorTypeSpec {
         fov: FovSpec::Square { half_width: 50.0 },
         speed: Some(3.into()),
         p_detect: Some(0.6),
+        elevated: None,
     }
 }
 
@@ -161,14 +171,90 @@ pub fn site_fleet_spec() -> ScenarioSpec {
     }
 }
 
+/// `site-campus`: the gated site of [`site_gates_spec`] (same gates,
+/// cones and mixes) built up, guarded by ground robots and drones:
+/// - eight buildings, which block sight, end the flight of a target that
+///   walks into them and keep robots off their cells: a main hall and a
+///   workshop either side of the site road, a warehouse, an office block,
+///   an octagonal silo, a depot, a gatehouse by the west gate and a shed
+///   across the east fence;
+/// - four screens, which block sight only: a tree line along the south
+///   fence, a copse by the road, a hedge in the north-east and a clump of
+///   trees in the north-west corner;
+/// - sensor types `robot` (the ground robot of [`site_robot`], also the
+///   type `default`) and `drone` ([`site_drone`], elevated: it sees over
+///   every obstacle and flies over buildings).
+pub fn site_campus_spec() -> ScenarioSpec {
+    let building = |points: &[(f64, f64)]| ObstacleSpec {
+        polygon: points.iter().map(|&(x, y)| [x, y]).collect(),
+        kind: None,
+    };
+    let screen = |points: &[(f64, f64)]| ObstacleSpec {
+        kind: Some("screen".into()),
+        ..building(points)
+    };
+    let rect = |x0, y0, x1, y1| [(x0, y0), (x1, y0), (x1, y1), (x0, y1)];
+    let octagon = |cx: f64, cy: f64, r: f64| -> Vec<(f64, f64)> {
+        (0..8)
+            .map(|i| {
+                let a = std::f64::consts::FRAC_PI_4 * (f64::from(i) + 0.5);
+                (cx + r * a.cos(), cy + r * a.sin())
+            })
+            .collect()
+    };
+    let robot = site_robot();
+    ScenarioSpec {
+        name: Some("campus: the gated site among buildings and trees, robots and drones".into()),
+        fov: robot.fov,
+        p_detect: robot.p_detect,
+        sensor_types: Some(BTreeMap::from([
+            (
+                "drone".to_owned(),
+                SensorTypeSpec {
+                    elevated: Some(true),
+                    ..site_drone()
+                },
+            ),
+            ("robot".to_owned(), robot),
+        ])),
+        obstacles: Some(vec![
+            building(&rect(60.0, 180.0, 130.0, 240.0)),
+            building(&rect(60.0, 60.0, 120.0, 110.0)),
+            building(&rect(170.0, 170.0, 250.0, 230.0)),
+            building(&rect(180.0, 60.0, 230.0, 120.0)),
+            building(&octagon(300.0, 90.0, 20.0)),
+            building(&rect(290.0, 180.0, 360.0, 230.0)),
+            building(&rect(20.0, 165.0, 35.0, 180.0)),
+            building(&[
+                (370.0, 100.0),
+                (420.0, 110.0),
+                (410.0, 150.0),
+                (375.0, 140.0),
+            ]),
+            screen(&rect(140.0, 20.0, 240.0, 30.0)),
+            screen(&octagon(150.0, 125.0, 12.0)),
+            screen(&[
+                (260.0, 240.0),
+                (330.0, 265.0),
+                (325.0, 275.0),
+                (255.0, 250.0),
+            ]),
+            screen(&[(20.0, 250.0), (60.0, 250.0), (40.0, 285.0)]),
+        ]),
+        ..site_gates_spec()
+    }
+}
+
 /// The built-in scenarios: `paper-v10` and `paper-v15` (the paper's),
-/// `site-gates` ([`site_gates_spec`]) and `site-fleet` ([`site_fleet_spec`]).
+/// `site-gates` ([`site_gates_spec`]), `site-fleet` ([`site_fleet_spec`])
+/// and `site-campus` ([`site_campus_spec`]).
 pub fn builtins() -> Vec<Scenario> {
     [
         paper_spec(10.0),
         paper_spec(15.0),
         site_gates_spec(),
         site_fleet_spec(),
+        site_campus_spec(),
     ]
     .into_iter()
     .zip(BUILTIN_IDS)

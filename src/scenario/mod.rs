@@ -15,19 +15,23 @@ use crate::geometry::{Disk, Point, Rect, Region};
 use crate::limits::{
     DEFAULT_HORIZON, DEFAULT_RAYS_PER_PI_CIRCLE, DEFAULT_RAYS_PER_PI_SQUARE, MAX_CELL_STATS,
     MAX_CELLS, MAX_NAME_CHARS, MAX_POPULATION, MAX_RAYS_PER_PI, MAX_SOURCES, MIN_RAYS_PER_PI,
+    OBSTACLE_STATS_RAYS_PER_PI,
 };
+use crate::obstacle::{Obstacles, Sight};
 
 mod builtins;
 mod input;
+mod obstacles;
 mod sensor;
 mod source;
 
 pub use builtins::{
-    BUILTIN_IDS, SITE_CYCLIST, SITE_VEHICLE, SITE_WALKER, builtins, paper_spec, site_drone,
-    site_fleet_spec, site_gates_spec, site_robot,
+    BUILTIN_IDS, SITE_CYCLIST, SITE_VEHICLE, SITE_WALKER, builtins, paper_spec, site_campus_spec,
+    site_drone, site_fleet_spec, site_gates_spec, site_robot,
 };
 
 pub use input::{Integer, ValidationError, check_horizon, check_min_separation};
+pub use obstacles::{ObstacleKindName, ObstacleSpec};
 pub use sensor::{DEFAULT_TYPE, FovSpec, Look, NoGoSpec, SensorType, SensorTypeSpec, all_certain};
 pub use source::{Heading, Source, SourceSpec, SpeedSpec, TargetClass, infer_heading};
 
@@ -76,6 +80,13 @@ pub struct ScenarioSpec {
     /// these rectangles (edges included) is blocked. Targets fly over it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub no_go: Option<Vec<NoGoSpec>>,
+    /// Buildings and screens (at most 64 convex polygons): sight lines
+    /// that meet an obstacle's interior are blocked (elevated sensor types
+    /// see over them), a target's flight ends where it enters a building,
+    /// and no ground sensor stands on or crosses a cell whose centre lies
+    /// in a building (see `docs/obstacles.md`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub obstacles: Option<Vec<ObstacleSpec>>,
     /// Distance a target flies per step, for the sources that give no
     /// `speeds` (required unless every source gives them).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -135,11 +146,21 @@ pub struct Scenario {
     pub fov: FovSpec,
     /// Sensor types; `types[0]` is `default`, the others follow by name.
     pub types: Vec<SensorType>,
-    /// The distinct fields of view of the types (`fovs[0]` is `fov`).
+    /// The distinct views of the types (`fovs[0]` is `fov`): a field of
+    /// view, and whether its looks see over the obstacles
+    /// (`sees_over[slot]`; always true without obstacles).
     pub fovs: Vec<FovSpec>,
+    /// Aligned with `fovs`: true when that view's looks see over every
+    /// obstacle (an elevated type's, or any without obstacles).
+    pub sees_over: Vec<bool>,
     /// Row-major: true for a cell no sensor may stand on. Empty when no
     /// cell is blocked.
     blocked: Vec<bool>,
+    /// Row-major: true for a cell whose centre lies in a building, where
+    /// no ground sensor may stand. Empty without buildings.
+    in_building: Vec<bool>,
+    /// Buildings and screens.
+    pub obstacles: Obstacles,
     /// Sources.
     pub sources: Vec<Source>,
     /// Target classes (source × speed), grouped by source in source order.
@@ -212,14 +233,36 @@ impl Scenario {
                 ),
             ));
         }
+        let zone = Rect {
+            x0: 0.0,
+            y0: 0.0,
+            x1: width,
+            y1: height,
+        };
+        let (obstacles, canonical_obstacles) =
+            obstacles::validate(spec.obstacles.as_deref().unwrap_or(&[]), &zone)?;
         let fleet = sensor::validate_fleet(
             &spec.fov,
             spec.sensor_speed.as_ref(),
             spec.p_detect,
             spec.sensor_types.as_ref(),
+            !obstacles.is_empty(),
         )?;
         let blocked =
             sensor::blocked_cells(spec.no_go.as_deref().unwrap_or(&[]), cols, rows, cell_size)?;
+        let in_building = if obstacles.in_building_anywhere() {
+            (0..rows)
+                .flat_map(|row| (0..cols).map(move |col| (col, row)))
+                .map(|(col, row)| {
+                    obstacles.in_building(Point::new(
+                        (f64::from(col) + 0.5) * cell_size,
+                        (f64::from(row) + 0.5) * cell_size,
+                    ))
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         if fleet.fovs.len() > 1
             && cols as u64 * rows as u64 * fleet.fovs.len() as u64 > MAX_CELL_STATS as u64
         {
@@ -260,6 +303,9 @@ impl Scenario {
                 rate: v.source.rate * weight,
             }));
             class_offsets.push(classes.len());
+            if !obstacles.is_empty() {
+                reaches_zone(i, &v.source, &obstacles, &zone)?;
+            }
             sources.push(v.source);
             canonical_sources.push(v.canonical);
         }
@@ -290,6 +336,7 @@ impl Scenario {
             p_detect: fleet.p_detect,
             sensor_types: fleet.sensor_types,
             no_go: spec.no_go.filter(|v| !v.is_empty()),
+            obstacles: (!canonical_obstacles.is_empty()).then_some(canonical_obstacles),
             ..spec
         };
         let id = match id {
@@ -307,7 +354,10 @@ impl Scenario {
             fov: spec.fov,
             types: fleet.types,
             fovs: fleet.fovs,
+            sees_over: fleet.sees_over,
             blocked,
+            in_building,
+            obstacles,
             sources,
             classes,
             class_offsets,
@@ -322,21 +372,78 @@ impl Scenario {
         self.types.iter().position(|t| t.name == name)
     }
 
-    /// True when no sensor may stand on `c` (a cell on the lattice).
+    /// Why no sensor of type `ty` may stand on `c` (a cell on the
+    /// lattice), or `None` when it may: the cell is in a no-go zone, or
+    /// (for a ground type) its centre lies in a building.
     #[inline]
-    pub fn is_blocked(&self, c: Cell) -> bool {
-        !self.blocked.is_empty() && self.blocked[self.index(c)]
+    pub fn blocked_for(&self, ty: usize, c: Cell) -> Option<&'static str> {
+        if !self.blocked.is_empty() && self.blocked[self.index(c)] {
+            return Some("is in a no-go zone: no sensor may stand on it");
+        }
+        if !self.in_building.is_empty()
+            && !self.types[ty].elevated
+            && self.in_building[self.index(c)]
+        {
+            return Some("is in a building: no ground sensor may stand on it");
+        }
+        None
     }
 
-    /// True when some cell is blocked.
+    /// True when some cell is blocked for some type.
     pub fn has_no_go(&self) -> bool {
-        !self.blocked.is_empty()
+        !self.blocked.is_empty() || !self.in_building.is_empty()
     }
 
-    /// True when a sensor may stand on `c`: on the lattice and not blocked.
+    /// True when a sensor of type `ty` may stand on `c`: on the lattice
+    /// and not blocked for it.
     #[inline]
-    pub fn is_free(&self, c: Cell) -> bool {
-        self.on_lattice(c) && !self.is_blocked(c)
+    pub fn is_free(&self, ty: usize, c: Cell) -> bool {
+        self.on_lattice(c) && self.blocked_for(ty, c).is_none()
+    }
+
+    /// What a look cannot see, when obstacles hide part of it.
+    pub fn sight(&self, look: &Look) -> Option<Sight> {
+        self.obstacles.sight(look.from?, &look.region)
+    }
+
+    /// True when `look` can detect a target at `p`: inside its field of
+    /// view, and on a sight line that no obstacle blocks (for a ground
+    /// sensor).
+    pub fn detects(&self, look: &Look, p: Point) -> bool {
+        look.region.contains(p) && look.from.is_none_or(|from| self.obstacles.clear(from, p))
+    }
+
+    /// The outline of what `look` sees, for pictures: the point where each
+    /// of `rays` rays from its viewpoint, evenly spaced in angle, leaves
+    /// its field of view or first enters an obstacle's interior (for a
+    /// ground look; an elevated look's outline is its field of view's).
+    /// A polygon, counter-clockwise from east; exact for a ray's angle,
+    /// and between rays as fine as `rays` makes it.
+    pub fn view_outline(&self, look: &Look, rays: usize) -> Vec<Point> {
+        let r = &look.region;
+        // Any point of the (convex) field of view sees all of it when
+        // nothing blocks sight.
+        let p = look.from.or(r.disk.map(|d| d.c)).unwrap_or(Point::new(
+            0.5 * (r.rect.x0 + r.rect.x1),
+            0.5 * (r.rect.y0 + r.rect.y1),
+        ));
+        (0..rays)
+            .map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / rays as f64;
+                let d = Point::new(a.cos(), a.sin());
+                let inv = Point::new(1.0 / d.x, 1.0 / d.y);
+                let mut reach = r.ray(p, d, inv).map_or(0.0, |(_, b)| b);
+                if look.from.is_some() {
+                    reach = reach.min(self.obstacles.sight_reach(p, d));
+                }
+                Point::new(p.x + reach * d.x, p.y + reach * d.y)
+            })
+            .collect()
+    }
+
+    /// True when the scenario has obstacles.
+    pub fn has_obstacles(&self) -> bool {
+        !self.obstacles.is_empty()
     }
 
     /// The fastest sensor type's speed, cells per step.
@@ -366,9 +473,11 @@ impl Scenario {
     #[inline]
     pub fn look(&self, ty: usize, c: Cell) -> Look {
         let t = &self.types[ty];
+        let centre = self.centre(c);
         Look {
-            region: self.fov_with(t.fov, self.centre(c)),
+            region: self.fov_with(t.fov, centre),
             p_detect: t.p_detect,
+            from: (!self.sees_over[t.fov_slot]).then_some(centre),
         }
     }
 
@@ -496,6 +605,40 @@ impl Scenario {
             rect: self.zone(),
             disk: None,
         }
+    }
+}
+
+/// Refuses source `i` when no direction of its cone reaches the zone's
+/// interior before a building ends its flight (a source inside a
+/// building among them), checked on a grid of
+/// [`OBSTACLE_STATS_RAYS_PER_PI`] rays per π.
+fn reaches_zone(
+    i: usize,
+    source: &Source,
+    obstacles: &Obstacles,
+    zone: &Rect,
+) -> Result<(), ValidationError> {
+    if obstacles.inside_building(source.pos) {
+        return Err(ValidationError::new(
+            format!("sources[{i}]"),
+            "lies inside a building: every target it emits is stopped at once",
+        ));
+    }
+    let (lo, hi) = source.cone;
+    let n = ((hi - lo) / std::f64::consts::PI * OBSTACLE_STATS_RAYS_PER_PI as f64).ceil() as usize;
+    let reaches = (0..n.max(1)).any(|m| {
+        let d = source.direction(lo + (hi - lo) * (m as f64 + 0.5) / n.max(1) as f64);
+        let inv = Point::new(1.0 / d.x, 1.0 / d.y);
+        zone.ray(source.pos, d, inv)
+            .is_some_and(|(a, b)| b > a && obstacles.stop(source.pos, d) > a)
+    });
+    if reaches {
+        Ok(())
+    } else {
+        Err(ValidationError::new(
+            format!("sources[{i}]"),
+            "every direction of its cone meets a building before the zone: no target it emits can enter",
+        ))
     }
 }
 

@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use super::input::{Integer, ValidationError};
-use crate::geometry::Region;
+use crate::geometry::{Point, Region};
 use crate::limits::{MAX_NO_GO, MAX_SENSOR_SPEED, MAX_SENSOR_TYPES, MAX_TYPE_NAME_CHARS};
 
 /// Name of the type made of the scenario's top-level `fov`.
@@ -59,6 +59,11 @@ pub struct SensorTypeSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(exclusive_minimum = 0, maximum = 1)]
     pub p_detect: Option<f64>,
+    /// True for a type that sees over every obstacle and may fly over
+    /// buildings (a drone); false by default (a ground sensor, whose sight
+    /// lines obstacles block and which never stands on a building's cell).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub elevated: Option<bool>,
 }
 
 /// A validated sensor type.
@@ -72,9 +77,12 @@ pub struct SensorType {
     pub speed: usize,
     /// Detection probability, in (0, 1].
     pub p_detect: f64,
-    /// Index of its field of view among the scenario's distinct ones
-    /// ([`super::Scenario::fovs`]): types that share a field of view share
-    /// its statistics.
+    /// Sees over obstacles and flies over buildings.
+    pub elevated: bool,
+    /// Index of its view among the scenario's distinct ones
+    /// ([`super::Scenario::fovs`] and [`super::Scenario::sees_over`]):
+    /// types that share a field of view, and with obstacles whether they
+    /// see over them, share its statistics.
     pub fov_slot: usize,
 }
 
@@ -101,6 +109,11 @@ pub struct Look {
     pub region: Region,
     /// Detection probability, in (0, 1].
     pub p_detect: f64,
+    /// The viewpoint whose sight lines the scenario's obstacles block (a
+    /// ground sensor's cell centre), or `None` when nothing blocks them
+    /// (an elevated sensor, or no obstacles): the look detects only the
+    /// part of `region` it sees.
+    pub from: Option<Point>,
 }
 
 impl Look {
@@ -109,6 +122,7 @@ impl Look {
         Look {
             region,
             p_detect: 1.0,
+            from: None,
         }
     }
 
@@ -167,6 +181,7 @@ fn valid_name(name: &str) -> bool {
 pub(super) struct Fleet {
     pub types: Vec<SensorType>,
     pub fovs: Vec<FovSpec>,
+    pub sees_over: Vec<bool>,
     pub sensor_speed: Option<Integer>,
     pub p_detect: Option<f64>,
     pub sensor_types: Option<BTreeMap<String, SensorTypeSpec>>,
@@ -174,22 +189,26 @@ pub(super) struct Fleet {
 
 /// Validates the top-level field of view, `sensor_speed`, `p_detect` and
 /// `sensor_types`. Canonical forms drop defaults, so a spec that uses none
-/// of the fleet's fields keeps the id it had before they existed.
+/// of the fleet's fields keeps the id it had before they existed. With
+/// `obstacles`, types that see over them get views of their own.
 pub(super) fn validate_fleet(
     fov: &FovSpec,
     sensor_speed: Option<&Integer>,
     p_detect: Option<f64>,
     sensor_types: Option<&BTreeMap<String, SensorTypeSpec>>,
+    obstacles: bool,
 ) -> Result<Fleet, ValidationError> {
     check_fov("fov", fov)?;
     let speed = check_speed("sensor_speed", sensor_speed)?;
     let p = check_p_detect("p_detect", p_detect)?;
     let mut fovs = vec![*fov];
+    let mut sees_over = vec![!obstacles];
     let mut types = vec![SensorType {
         name: DEFAULT_TYPE.into(),
         fov: *fov,
         speed,
         p_detect: p,
+        elevated: false,
         fov_slot: 0,
     }];
     let named = sensor_types.map_or(0, BTreeMap::len);
@@ -219,18 +238,23 @@ pub(super) fn validate_fleet(
         check_fov(&format!("{field}.fov"), &spec.fov)?;
         let speed = check_speed(&format!("{field}.speed"), spec.speed.as_ref())?;
         let p = check_p_detect(&format!("{field}.p_detect"), spec.p_detect)?;
-        let fov_slot = match fovs.iter().position(|f| *f == spec.fov) {
-            Some(i) => i,
-            None => {
-                fovs.push(spec.fov);
-                fovs.len() - 1
-            }
-        };
+        let elevated = spec.elevated.unwrap_or(false);
+        let over = elevated || !obstacles;
+        let fov_slot =
+            match (fovs.iter().zip(&sees_over)).position(|(f, &o)| *f == spec.fov && o == over) {
+                Some(i) => i,
+                None => {
+                    fovs.push(spec.fov);
+                    sees_over.push(over);
+                    fovs.len() - 1
+                }
+            };
         types.push(SensorType {
             name: name.clone(),
             fov: spec.fov,
             speed,
             p_detect: p,
+            elevated,
             fov_slot,
         });
         canonical.insert(
@@ -239,6 +263,7 @@ pub(super) fn validate_fleet(
                 fov: spec.fov,
                 speed: (speed != 1).then(|| speed.into()),
                 p_detect: (p != 1.0).then_some(p),
+                elevated: elevated.then_some(true),
             },
         );
     }
@@ -248,6 +273,7 @@ pub(super) fn validate_fleet(
         sensor_types: (!canonical.is_empty()).then_some(canonical),
         types,
         fovs,
+        sees_over,
     })
 }
 
@@ -339,10 +365,11 @@ mod tests {
             fov,
             speed: Some(speed.into()),
             p_detect: Some(p),
+            elevated: None,
         };
         let one = |name: &str, s: SensorTypeSpec| BTreeMap::from([(name.to_owned(), s)]);
         let err = |m: BTreeMap<String, SensorTypeSpec>| {
-            validate_fleet(&fov, None, None, Some(&m))
+            validate_fleet(&fov, None, None, Some(&m), false)
                 .err()
                 .map(|e| e.field)
         };
@@ -370,6 +397,7 @@ mod tests {
             Some(&1.into()),
             Some(1.0),
             Some(&one("a", spec(1, 1.0))),
+            false,
         )
         .expect("valid");
         assert_eq!(f.sensor_speed, None);

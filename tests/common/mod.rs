@@ -6,9 +6,10 @@ use std::collections::HashSet;
 use vigil::scenario::{Cell, Scenario};
 
 /// The cells within `speed` king moves of `from` through free cells (on
-/// the lattice, not blocked): the legal one-step moves of a sensor of that
-/// speed, by a breadth-first search of the tests' own.
-pub fn one_step(s: &Scenario, from: Cell, speed: usize) -> HashSet<Cell> {
+/// the lattice, not blocked for the type): the legal one-step moves of a
+/// sensor of type `ty`, by a breadth-first search of the tests' own.
+pub fn one_step(s: &Scenario, from: Cell, ty: usize) -> HashSet<Cell> {
+    let speed = s.types[ty].speed;
     let mut frontier = vec![from];
     let mut seen = HashSet::from([from]);
     for _ in 0..speed {
@@ -20,7 +21,7 @@ pub fn one_step(s: &Scenario, from: Cell, speed: usize) -> HashSet<Cell> {
                         col: c.col + dc,
                         row: c.row + dr,
                     };
-                    if s.is_free(n) && seen.insert(n) {
+                    if s.is_free(ty, n) && seen.insert(n) {
                         next.push(n);
                     }
                 }

@@ -104,7 +104,11 @@ async fn shared_catalogue(cluster: Arc<Cluster>) {
         .find(|s| s["id"] == id.as_str())
         .unwrap_or_else(|| panic!("{id} not listed by B: {list}"));
     assert_eq!(listed["status"], "stored", "{listed}");
-    assert_eq!(list["scenarios"].as_array().unwrap().len(), 5, "{list}");
+    assert_eq!(
+        list["scenarios"].as_array().unwrap().len(),
+        vigil::scenario::BUILTIN_IDS.len() + 1,
+        "{list}"
+    );
 
     // B serves it on its first request.
     let (status, got) = body(b.get(&format!("/v1/scenarios/{id}")).await).await;

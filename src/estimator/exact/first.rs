@@ -162,6 +162,10 @@ impl<'e> FirstDetections<'e> {
     /// Appends the pieces of `look` taken at step `t`, sorted by key.
     fn pieces(&self, look: &Look, t: usize, out: &mut Vec<Piece>, buf: &mut Vec<Point>) {
         let mut on_rays: Vec<(u32, f64, f64)> = Vec::new();
+        // With obstacles, only what the look sees of each ray, before a
+        // building ends the flights along it (see `sighted`).
+        let sight = self.est.scenario.sight(look);
+        let mut visible = Vec::new();
         for (ri, sr) in self.est.rays.iter().enumerate() {
             let classes = self.classes_of_rays[ri].clone();
             if classes.is_empty() {
@@ -171,11 +175,27 @@ impl<'e> FirstDetections<'e> {
                 continue;
             };
             on_rays.clear();
-            on_rays.extend((a..b).filter_map(|m| {
+            for m in a..b {
                 let (d, inv) = sr.dirs[m];
-                let (lo, hi) = look.region.ray(sr.source.pos, d, inv)?;
-                (hi > lo).then_some((m as u32, lo, hi))
-            }));
+                let Some((lo, hi)) = look.region.ray(sr.source.pos, d, inv) else {
+                    continue;
+                };
+                let hi = hi.min(sr.stop(m));
+                match &sight {
+                    None if hi > lo => on_rays.push((m as u32, lo, hi)),
+                    None => {}
+                    Some(v) => {
+                        visible.clear();
+                        v.visible(sr.source.pos, d, lo, hi.max(lo), &mut visible);
+                        on_rays.extend(
+                            visible
+                                .iter()
+                                .filter(|(p, q)| q > p)
+                                .map(|&(p, q)| (m as u32, p, q)),
+                        );
+                    }
+                }
+            }
             for c in classes {
                 let class = &self.est.classes[c];
                 let shift = class.speed * t as f64;

@@ -8,6 +8,7 @@
 mod first;
 mod rays;
 mod seen;
+mod sighted;
 #[cfg(test)]
 mod tests;
 mod windows;
@@ -26,6 +27,7 @@ use windows::{SeenRays, StepWindows, Window};
 use super::elementary::ElementaryGrid;
 use super::{Elements, Estimator, Target};
 use crate::geometry::{Point, Region, detection_within, union_within};
+use crate::obstacle::Sight;
 use crate::scenario::{Cell, Look, Scenario};
 use crate::search::ValueGrid;
 use crate::stats::Stats;
@@ -174,10 +176,20 @@ impl<'a> ExactEstimator<'a> {
             .collect();
         // Each look's field of view as indexed by the rays, once for all
         // the classes.
-        let keys: Vec<Vec<Option<LookKey>>> = if rays.iter().any(|r| r.looks.is_some()) {
+        let keys: Vec<Vec<Option<LookKey>>> =
+            if rays.iter().any(|r| r.looks.is_some()) && !scenario.has_obstacles() {
+                observed
+                    .iter()
+                    .map(|step| step.iter().map(|l| look_key(scenario, &l.region)).collect())
+                    .collect()
+            } else {
+                Vec::new()
+            };
+        // What each look cannot see, once for all the classes.
+        let sights: Vec<Vec<Option<Sight>>> = if scenario.has_obstacles() {
             observed
                 .iter()
-                .map(|step| step.iter().map(|l| look_key(scenario, &l.region)).collect())
+                .map(|step| step.iter().map(|l| scenario.sight(l)).collect())
                 .collect()
         } else {
             Vec::new()
@@ -185,7 +197,7 @@ impl<'a> ExactEstimator<'a> {
         let seen = classes
             .par_iter()
             .with_min_len(crate::parallel::min_len())
-            .map(|c| RayHits::new(&rays[c.rays], observed, &keys, c.speed))
+            .map(|c| RayHits::new(&rays[c.rays], observed, &keys, &sights, c.speed))
             .collect();
 
         let grid = grid.filter(|_| scenario.all_square());
@@ -374,6 +386,9 @@ impl<'a> ExactEstimator<'a> {
 
     /// The same value by the general path, for checks.
     pub fn value_by_rays(&self, sensor: usize, k: Cell, t: usize, excluded: &[Look]) -> f64 {
+        if self.scenario.has_obstacles() {
+            return self.value_sighted(sensor, k, t, excluded);
+        }
         let ty = &self.scenario.types[self.types[sensor]];
         let fk = self.scenario.fov_region_of(self.types[sensor], k);
         let excluded: Vec<&Look> = excluded
@@ -417,6 +432,9 @@ impl Estimator for ExactEstimator<'_> {
     }
 
     fn value(&self, sensor: usize, k: Cell, t: usize, excluded: &[Look]) -> f64 {
+        if self.scenario.has_obstacles() {
+            return self.value_sighted(sensor, k, t, excluded);
+        }
         let ty = &self.scenario.types[self.types[sensor]];
         let fk = self.scenario.fov_region_of(self.types[sensor], k);
         let near: Vec<&Look> = excluded

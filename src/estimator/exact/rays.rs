@@ -51,6 +51,9 @@ pub struct SourceRays {
     /// zone at every step, so the seen sets leave it out (see
     /// [`RayHits`](super::seen::RayHits)).
     pub(super) beyond: Vec<f64>,
+    /// Per ray, where a building ends the flight of a target on it (see
+    /// [`crate::obstacle::Obstacles::stop`]); empty without buildings.
+    pub(super) stops: Vec<f64>,
     /// Index of the source in the scenario.
     pub(super) source_index: usize,
     /// Where each ray crosses the elementary grid, when indexed.
@@ -211,6 +214,13 @@ impl Crossings {
 }
 
 impl SourceRays {
+    /// Where a building ends the flights along ray `m` (`+∞` when none
+    /// does).
+    #[inline]
+    pub(super) fn stop(&self, m: usize) -> f64 {
+        self.stops.get(m).copied().unwrap_or(f64::INFINITY)
+    }
+
     /// The grids of every source of a scenario with a non-zero rate, at
     /// its rays per π ([`Scenario::rays_per_pi`]).
     pub fn for_scenario(s: &Scenario) -> Vec<SourceRays> {
@@ -262,12 +272,20 @@ impl SourceRays {
                             .map_or(f64::INFINITY, |(_, r1)| r1 + 1e-9 * (1.0 + r1.abs()))
                     })
                     .collect();
+                let stops = if s.obstacles.in_building_anywhere() {
+                    dirs.iter()
+                        .map(|&(d, _)| s.obstacles.stop(src.pos, d))
+                        .collect()
+                } else {
+                    Vec::new()
+                };
                 Some(SourceRays {
                     source: *src,
                     lo,
                     step,
                     dirs,
                     beyond,
+                    stops,
                     source_index: j,
                     crossings: None,
                     looks: None,
@@ -374,7 +392,12 @@ impl SourceRays {
     /// (`LookCrossings`), for scenarios of at most
     /// `MAX_INDEXED_LOOKS` (16 384) such fields of view, a few MB per
     /// source; others compute them per plan (the same values, more slowly).
+    /// Not with obstacles: the index holds whole squares, and a ground
+    /// look sees only part of its square.
     pub fn index_looks(rays: &mut [SourceRays], s: &Scenario) {
+        if s.has_obstacles() {
+            return;
+        }
         let slots: Vec<bool> = (0..s.fovs.len()).map(|slot| indexes(s, slot)).collect();
         let indexed = slots.iter().filter(|&&x| x).count();
         let keys = s.fovs.len() * s.cell_count();
@@ -458,6 +481,7 @@ impl SourceRays {
     /// Approximate heap memory held, bytes.
     pub fn memory_bytes(&self) -> usize {
         (std::mem::size_of::<(Point, Point)>() + 8) * self.dirs.len()
+            + 8 * self.stops.len()
             + self.crossings.as_ref().map_or(0, |c| {
                 4 * c.offsets.len()
                     + 8 * c.r.len()

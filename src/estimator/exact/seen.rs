@@ -10,6 +10,7 @@
 
 use super::rays::{LookKey, SourceRays, max, min, slab};
 use crate::geometry::OpenIntervals;
+use crate::obstacle::Sight;
 use crate::scenario::{Look, all_certain};
 
 /// What the rays of one source saw: per ray, the union of the intervals
@@ -40,17 +41,21 @@ impl RayHits {
     /// The seen sets of the rays `sr` for a class of speed `speed`.
     /// `keys[s][i]` is the key of `observed[s][i]`'s field of view in the
     /// rays' [`LookCrossings`](super::rays::LookCrossings) (see
-    /// [`look_key`](super::rays::look_key)), or `None`.
+    /// [`look_key`](super::rays::look_key)), or `None`. `sights[s][i]` is
+    /// what `observed[s][i]` cannot see, when obstacles hide part of it
+    /// (`sights` is empty in a scenario without obstacles): its seen set
+    /// holds only the visible parts of its intervals.
     pub(super) fn new(
         sr: &SourceRays,
         observed: &[Vec<Look>],
         keys: &[Vec<Option<LookKey>>],
+        sights: &[Vec<Option<Sight>>],
         speed: f64,
     ) -> Self {
-        if observed.iter().all(|step| all_certain(step)) {
+        if sights.is_empty() && observed.iter().all(|step| all_certain(step)) {
             Self::union(sr, observed, keys, speed)
         } else {
-            Self::weighted(sr, observed, keys, speed)
+            Self::weighted(sr, observed, keys, sights, speed)
         }
     }
 
@@ -63,9 +68,11 @@ impl RayHits {
         sr: &SourceRays,
         observed: &[Vec<Look>],
         keys: &[Vec<Option<LookKey>>],
+        sights: &[Vec<Option<Sight>>],
         speed: f64,
     ) -> Self {
         let mut buf = Vec::new();
+        let mut visible = Vec::new();
         let o = sr.source.pos;
         let n = sr.dirs.len();
         let mut pieces: Vec<(u32, f64, f64, f64)> = Vec::new();
@@ -89,12 +96,26 @@ impl RayHits {
                 let Some((a, b)) = sr.range(&look.region, &mut buf) else {
                     continue;
                 };
+                let sight = sights
+                    .get(s)
+                    .and_then(|v| v.get(i))
+                    .and_then(Option::as_ref);
                 for m in a..b {
                     let (d, inv) = sr.dirs[m];
                     if let Some((p, q)) = look.region.ray(o, d, inv)
                         && p + shift <= sr.beyond[m]
                     {
-                        pieces.push((m as u32, p + shift, q + shift, look.p_detect));
+                        let Some(sight) = sight else {
+                            pieces.push((m as u32, p + shift, q + shift, look.p_detect));
+                            continue;
+                        };
+                        visible.clear();
+                        sight.visible(o, d, p, q, &mut visible);
+                        pieces.extend(
+                            visible
+                                .iter()
+                                .map(|&(p, q)| (m as u32, p + shift, q + shift, look.p_detect)),
+                        );
                     }
                 }
             }

@@ -8,8 +8,9 @@ use utoipa::openapi::{OpenApi, RefOr};
 
 use crate::limits::{
     MAX_BUDGET_MS, MAX_HISTORY_POSITIONS, MAX_HISTORY_STEPS, MAX_HORIZON, MAX_MIN_SEPARATION,
-    MAX_NAME_CHARS, MAX_NO_GO, MAX_RAYS_PER_PI, MAX_SENSOR_SPEED, MAX_SENSOR_TYPES, MAX_SENSORS,
-    MAX_SOURCES, MAX_SPEED_CLASSES, MAX_TARGETS, MAX_TYPE_NAME_CHARS, MIN_RAYS_PER_PI,
+    MAX_NAME_CHARS, MAX_NO_GO, MAX_OBSTACLE_VERTICES, MAX_OBSTACLES, MAX_RAYS_PER_PI,
+    MAX_SENSOR_SPEED, MAX_SENSOR_TYPES, MAX_SENSORS, MAX_SOURCES, MAX_SPEED_CLASSES, MAX_TARGETS,
+    MAX_TYPE_NAME_CHARS, MIN_OBSTACLE_VERTICES, MIN_RAYS_PER_PI,
 };
 
 /// A bound on one property.
@@ -25,6 +26,9 @@ enum Bound {
     MaxItemsEach(usize, usize),
     /// `maxLength` of a string.
     MaxLength(usize),
+    /// `minItems` and `maxItems` of an array of points, each exactly two
+    /// numbers.
+    Points(usize, usize),
 }
 
 /// The bodies shaped like a plan request (the planner's input).
@@ -95,6 +99,16 @@ const RULES: &[(&[&str], &str, Bound)] = &[
     (&["ScenarioSpec"], "no_go", Bound::MaxItems(MAX_NO_GO)),
     (
         &["ScenarioSpec"],
+        "obstacles",
+        Bound::MaxItems(MAX_OBSTACLES),
+    ),
+    (
+        &["ObstacleSpec"],
+        "polygon",
+        Bound::Points(MIN_OBSTACLE_VERTICES, MAX_OBSTACLE_VERTICES),
+    ),
+    (
+        &["ScenarioSpec"],
         "sensor_speed",
         Bound::Maximum(MAX_SENSOR_SPEED),
     ),
@@ -161,6 +175,16 @@ fn apply(schema: &mut Schema, bound: Bound) {
         }
         (Schema::Object(o), Bound::MaxLength(max)) => o.max_length = Some(max),
         (Schema::Array(a), Bound::MaxItems(max)) => a.max_items = Some(max),
+        (Schema::Array(a), Bound::Points(min, max)) => {
+            a.min_items = Some(min);
+            a.max_items = Some(max);
+            if let ArrayItems::RefOrSchema(item) = &mut a.items
+                && let RefOr::T(Schema::Array(item)) = item.as_mut()
+            {
+                item.min_items = Some(2);
+                item.max_items = Some(2);
+            }
+        }
         (Schema::Array(a), Bound::MaxItemsEach(outer, inner)) => {
             a.max_items = Some(outer);
             if let ArrayItems::RefOrSchema(item) = &mut a.items
