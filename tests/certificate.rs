@@ -1,6 +1,6 @@
 //! Certified plan quality on instances small enough to search whole: for
-//! random scenarios with sensor types, no-go ground and a few sensors over
-//! a short horizon, every joint combination of legal paths is scored
+//! random scenarios with sensor types, no-go ground (and, in two tests,
+//! a building and a screen) and a few sensors over a short horizon, every joint combination of legal paths is scored
 //! through the evaluate code, and for every coordination the plan's value
 //! is at most that true optimum, which is at most the plan's certified
 //! upper bound (the relaxation's, or the marginal bound where a circular
@@ -94,6 +94,60 @@ fn scenario(rng: &mut StdRng, fast: bool, circle: bool) -> Scenario {
         rays_per_pi: None,
     };
     Scenario::new(spec).unwrap()
+}
+
+/// `s` with a random building and a random screen (convex polygons of
+/// three to six vertices, a building across the zone's edge in a third of
+/// the instances) and its `wide` type elevated; drawn again when the
+/// building leaves a source no way into the zone.
+fn with_obstacles(rng: &mut StdRng, s: Scenario) -> Scenario {
+    loop {
+        let mut spec = s.spec.clone();
+        let polygon = |rng: &mut StdRng, cx: f64, cy: f64| -> Vec<[f64; 2]> {
+            let n = rng.random_range(3..=6);
+            let r = rng.random_range(6.0..18.0);
+            let mut angles: Vec<f64> = (0..n)
+                .map(|_| rng.random_range(0.0..std::f64::consts::TAU))
+                .collect();
+            angles.sort_by(f64::total_cmp);
+            angles
+                .iter()
+                .map(|a| [cx + r * a.cos(), cy + r * a.sin()])
+                .collect()
+        };
+        let (w, h) = (s.width, s.height);
+        let at_edge = rng.random_range(0..3) == 0;
+        let (bx, by) = if at_edge {
+            (w, rng.random_range(0.3 * h..0.7 * h))
+        } else {
+            (
+                rng.random_range(0.3 * w..0.7 * w),
+                rng.random_range(0.3 * h..0.7 * h),
+            )
+        };
+        let building = polygon(rng, bx, by);
+        let (sx, sy) = (
+            rng.random_range(0.2 * w..0.8 * w),
+            rng.random_range(0.2 * h..0.8 * h),
+        );
+        let screen = polygon(rng, sx, sy);
+        spec.obstacles = Some(vec![
+            vigil::scenario::ObstacleSpec {
+                polygon: building,
+                kind: None,
+            },
+            vigil::scenario::ObstacleSpec {
+                polygon: screen,
+                kind: Some("screen".to_owned()),
+            },
+        ]);
+        if let Some(wide) = spec.sensor_types.as_mut().and_then(|t| t.get_mut("wide")) {
+            wide.elevated = Some(true);
+        }
+        if let Ok(s) = Scenario::new(spec) {
+            return s;
+        }
+    }
 }
 
 /// The centre of a cell free for type `ty`.
@@ -264,7 +318,18 @@ fn evaluate_plan(planner: &Planner, req: &PlanRequest, plan: &PlanResponse) -> f
 
 #[test]
 fn plans_are_below_the_optimum_and_the_optimum_below_the_bound() {
-    let mut rng = StdRng::seed_from_u64(37);
+    detections_against_the_optimum(37, 24, false);
+}
+
+/// The same with a building and a screen in each instance and the `wide`
+/// type elevated.
+#[test]
+fn with_obstacles_plans_are_below_the_optimum_and_the_optimum_below_the_bound() {
+    detections_against_the_optimum(47, 8, true);
+}
+
+fn detections_against_the_optimum(seed: u64, count: usize, obstacles: bool) {
+    let mut rng = StdRng::seed_from_u64(seed);
     let modes = [
         Coordination::None,
         Coordination::Priority,
@@ -274,11 +339,14 @@ fn plans_are_below_the_optimum_and_the_optimum_below_the_bound() {
     let mut hits = [0usize; 4];
     let mut instances = 0;
     let mut worst_gap: f64 = 0.0;
-    while instances < 24 {
+    while instances < count {
         // Two sensors over three steps, or three over two (with a speed-2
         // type): at most ~5·10⁵ combinations.
         let three = instances % 2 == 1;
-        let s = scenario(&mut rng, three, instances % 4 == 3);
+        let mut s = scenario(&mut rng, three, instances % 4 == 3);
+        if obstacles {
+            s = with_obstacles(&mut rng, s);
+        }
         let horizon = if three { 2 } else { 3 };
         let n = if three { 3 } else { 2 };
         let names: Vec<&str> = if three {
@@ -387,7 +455,18 @@ fn first_optimum(evaluator: &Evaluator, paths: &[Vec<Vec<Cell>>]) -> f64 {
 /// evaluated score its value.
 #[test]
 fn first_detection_plans_are_below_the_optimum_and_the_optimum_below_the_bound() {
-    let mut rng = StdRng::seed_from_u64(41);
+    first_detections_against_the_optimum(41, 20, false);
+}
+
+/// The same with a building and a screen in each instance and the `wide`
+/// type elevated.
+#[test]
+fn with_obstacles_first_detection_plans_are_below_the_optimum_and_the_bound() {
+    first_detections_against_the_optimum(53, 8, true);
+}
+
+fn first_detections_against_the_optimum(seed: u64, instances: usize, obstacles: bool) {
+    let mut rng = StdRng::seed_from_u64(seed);
     let modes = [
         Coordination::None,
         Coordination::Priority,
@@ -396,10 +475,12 @@ fn first_detection_plans_are_below_the_optimum_and_the_optimum_below_the_bound()
     ];
     let mut found = [0usize; 4];
     let mut worst_gap: f64 = 0.0;
-    let instances = 20;
     for instance in 0..instances {
         let alone = instance % 2 == 0;
-        let s = scenario(&mut rng, instance % 3 == 1, instance % 5 == 4);
+        let mut s = scenario(&mut rng, instance % 3 == 1, instance % 5 == 4);
+        if obstacles {
+            s = with_obstacles(&mut rng, s);
+        }
         let (n, horizon) = if alone { (1, 4) } else { (2, 2) };
         let planner = Planner::new(s);
         let s = &planner.scenario;

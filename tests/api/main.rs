@@ -12,6 +12,7 @@ mod fuzz;
 mod helpers;
 mod intrusion;
 mod jobs;
+mod obstacles;
 mod openapi;
 mod ops;
 mod plan;

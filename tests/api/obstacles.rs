@@ -1,0 +1,353 @@
+//! Buildings and screens over HTTP: specs with obstacles register, plan,
+//! evaluate and step sessions; every malformed obstacle, every sensor on a
+//! building's cell and the paper estimator get a 422 naming the field.
+
+use reqwest::StatusCode;
+use serde_json::{Value, json};
+
+use crate::helpers::{TestApp, assert_validation, json_body, small_spec, spawn_app};
+
+/// `small_spec` with a building in the middle (cells (4..=5, 4..=5) have
+/// their centres in it), a screen in the south-west, a ground type
+/// `default` and an elevated `drone`.
+fn campus_spec() -> Value {
+    let mut spec = small_spec();
+    spec["p_detect"] = json!(0.9);
+    spec["sensor_types"] = json!({
+        "drone": {"fov": {"shape": "square", "half_width": 25.0}, "speed": 2,
+                  "p_detect": 0.6, "elevated": true}
+    });
+    spec["obstacles"] = json!([
+        {"polygon": [[40.0, 40.0], [60.0, 40.0], [60.0, 60.0], [40.0, 60.0]], "kind": "building"},
+        {"polygon": [[10.0, 10.0], [30.0, 12.0], [20.0, 30.0]], "kind": "screen"}
+    ]);
+    spec
+}
+
+async fn register(app: &TestApp, spec: &Value) -> String {
+    let res = app.post_json("/v1/scenarios", spec).await;
+    let status = res.status();
+    assert!(
+        status == StatusCode::CREATED || status == StatusCode::OK,
+        "{status}: {}",
+        res.text().await.unwrap()
+    );
+    json_body(res, status).await["id"]
+        .as_str()
+        .unwrap()
+        .to_owned()
+}
+
+fn request(sensors: Value) -> Value {
+    json!({"sensors": sensors, "targets": [{"x": 25.0, "y": 75.0, "vx": 5.0, "vy": 0.0}],
+           "history": [[{"x": 15.0, "y": 55.0}, {"x": 45.0, "y": 65.0, "type": "drone"}]]})
+}
+
+fn two_sensors() -> Value {
+    json!([{"id": "cam", "x": 25.0, "y": 55.0},
+           {"id": "uav", "x": 55.0, "y": 65.0, "type": "drone"}])
+}
+
+#[tokio::test]
+async fn a_spec_with_obstacles_registers_plans_evaluates_and_steps() {
+    let app = spawn_app().await;
+    // An empty list is no obstacles: the plain spec's id.
+    let plain = register(&app, &small_spec()).await;
+    let mut empty = small_spec();
+    empty["obstacles"] = json!([]);
+    assert_eq!(register(&app, &empty).await, plain);
+
+    let id = register(&app, &campus_spec()).await;
+    let got = json_body(
+        app.get(&format!("/v1/scenarios/{id}")).await,
+        StatusCode::OK,
+    )
+    .await;
+    // Canonical: a building's kind is the default and dropped.
+    assert_eq!(got["spec"]["obstacles"][0].get("kind"), None);
+    assert_eq!(got["spec"]["obstacles"][1]["kind"], "screen");
+    assert_eq!(got["spec"]["sensor_types"]["drone"]["elevated"], true);
+
+    // Statistics list the obstacles; a ground camera next to the building
+    // sees less than the same square from above.
+    let stats = |ty: &'static str| {
+        let app = &app;
+        let id = id.clone();
+        async move {
+            json_body(
+                app.get(&format!("/v1/scenarios/{id}/stats?type={ty}"))
+                    .await,
+                StatusCode::OK,
+            )
+            .await
+        }
+    };
+    let (ground, drone) = (stats("default").await, stats("drone").await);
+    assert_eq!(ground["obstacles"].as_array().unwrap().len(), 2);
+    let cell = 5 * 10 + 3; // (col 3, row 5), just west of the building
+    assert!(ground["d_hat"][cell].as_f64().unwrap() > 0.0);
+    let plain_stats = json_body(
+        app.get(&format!("/v1/scenarios/{plain}/stats")).await,
+        StatusCode::OK,
+    )
+    .await;
+    assert!(plain_stats.get("obstacles").is_none());
+    assert!(
+        ground["d_hat"][cell].as_f64().unwrap() < plain_stats["d_hat"][cell].as_f64().unwrap(),
+        "the building hides part of the camera's view"
+    );
+    assert!(drone["d_hat"][cell].as_f64().unwrap() > ground["d_hat"][cell].as_f64().unwrap());
+
+    // Plans: exact, both objectives, every coordination, with a bound.
+    for objective in ["detections", "first_detections"] {
+        for coordination in ["none", "priority", "iterated", "joint"] {
+            let mut body = request(two_sensors());
+            body["objective"] = json!(objective);
+            body["coordination"] = json!(coordination);
+            body["explain"] = json!(true);
+            let plan = json_body(
+                app.post_json(&format!("/v1/scenarios/{id}/plan"), &body)
+                    .await,
+                StatusCode::OK,
+            )
+            .await;
+            let value = plan["expected_detections"].as_f64().unwrap();
+            assert!(value > 0.0, "{plan}");
+            assert!(plan["bound"]["upper"].as_f64().unwrap() >= value - 1e-9);
+            // The camera never stands on the building's cells.
+            for c in plan["plans"][0]["path"].as_array().unwrap() {
+                let (col, row) = (c["col"].as_i64().unwrap(), c["row"].as_i64().unwrap());
+                assert!(!((4..=5).contains(&col) && (4..=5).contains(&row)), "{c}");
+            }
+            // Evaluate scores the plan's own paths at its value.
+            let mut eval = request(two_sensors());
+            eval["objective"] = json!(objective);
+            eval["paths"] = crate::helpers::paths_of(&plan);
+            let scored = json_body(
+                app.post_json(&format!("/v1/scenarios/{id}/evaluate"), &eval)
+                    .await,
+                StatusCode::OK,
+            )
+            .await;
+            let total = scored["expected_detections"].as_f64().unwrap();
+            assert!(
+                (total - value).abs() <= 1e-9 * value.max(1.0),
+                "{total} vs {value}"
+            );
+        }
+    }
+
+    // Sessions: created, stepped; a step plans as the stateless request.
+    let res = app
+        .post_json(
+            "/v1/sessions",
+            &json!({"scenario_id": id, "history_steps": 4}),
+        )
+        .await;
+    let info = json_body(res, StatusCode::CREATED).await;
+    let sid = info["id"].as_str().unwrap();
+    let step = json_body(
+        app.post_json(
+            &format!("/v1/sessions/{sid}/step"),
+            &json!({"sensors": two_sensors()}),
+        )
+        .await,
+        StatusCode::OK,
+    )
+    .await;
+    let stateless = json_body(
+        app.post_json(
+            &format!("/v1/scenarios/{id}/plan"),
+            &json!({"sensors": two_sensors()}),
+        )
+        .await,
+        StatusCode::OK,
+    )
+    .await;
+    assert_eq!(step["plans"], stateless["plans"]);
+
+    // The paper estimator has no sight lines: refused, in plans and
+    // sessions alike.
+    let mut paper = request(two_sensors());
+    paper["estimator"] = json!("paper");
+    assert_validation(
+        app.post_json(&format!("/v1/scenarios/{id}/plan"), &paper)
+            .await,
+        "estimator",
+    )
+    .await;
+    assert_validation(
+        app.post_json(
+            "/v1/sessions",
+            &json!({"scenario_id": id, "estimator": "paper"}),
+        )
+        .await,
+        "estimator",
+    )
+    .await;
+}
+
+#[tokio::test]
+async fn ground_sensors_keep_off_buildings_and_drones_fly_over() {
+    let app = spawn_app().await;
+    let id = register(&app, &campus_spec()).await;
+    let plan = |body: Value| {
+        let app = &app;
+        let id = id.clone();
+        async move {
+            app.post_json(&format!("/v1/scenarios/{id}/plan"), &body)
+                .await
+        }
+    };
+    // A camera on the building's cell (4, 4), now and in the history.
+    assert_validation(
+        plan(json!({"sensors": [{"id": 1, "x": 45.0, "y": 45.0}]})).await,
+        "sensors[0]",
+    )
+    .await;
+    assert_validation(
+        plan(json!({"sensors": [{"id": 1, "x": 25.0, "y": 25.0}],
+                    "history": [[{"x": 55.0, "y": 55.0}]]}))
+        .await,
+        "history[0][0]",
+    )
+    .await;
+    // A drone may stand there.
+    json_body(
+        plan(json!({"sensors": [{"id": 1, "x": 45.0, "y": 45.0, "type": "drone"}]})).await,
+        StatusCode::OK,
+    )
+    .await;
+    // A camera inside the screen plans (it sees nothing from there).
+    let blind = json_body(
+        plan(json!({"sensors": [{"id": 1, "x": 25.0, "y": 15.0}], "horizon": 1})).await,
+        StatusCode::OK,
+    )
+    .await;
+    assert!(blind["expected_detections"].as_f64().unwrap() >= 0.0);
+    // Evaluate refuses a camera's path through the building.
+    let body = json!({"sensors": [{"id": 1, "x": 35.0, "y": 45.0}], "horizon": 2,
+        "paths": [{"sensor": 1, "path": [{"col": 4, "row": 4}, {"col": 5, "row": 4}]}]});
+    assert_validation(
+        app.post_json(&format!("/v1/scenarios/{id}/evaluate"), &body)
+            .await,
+        "paths[0].path[0]",
+    )
+    .await;
+}
+
+#[tokio::test]
+async fn malformed_obstacles_are_refused_naming_the_field() {
+    let app = spawn_app().await;
+    let with = |obstacles: Value| {
+        let mut spec = small_spec();
+        spec["obstacles"] = obstacles;
+        spec
+    };
+    let square = json!([[40.0, 40.0], [60.0, 40.0], [60.0, 60.0], [40.0, 60.0]]);
+    let cases: Vec<(Value, &str)> = vec![
+        // Non-convex: a dart.
+        (
+            with(json!([{"polygon": square},
+                {"polygon": [[0.0, 0.0], [20.0, 0.0], [10.0, 5.0], [20.0, 20.0], [0.0, 20.0]]}])),
+            "obstacles[1].polygon",
+        ),
+        // Three collinear vertices.
+        (
+            with(json!([{"polygon": [[0.0, 0.0], [10.0, 0.0], [20.0, 0.0], [10.0, 10.0]]}])),
+            "obstacles[0].polygon",
+        ),
+        // A repeated vertex.
+        (
+            with(json!([{"polygon": [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 0.0]]}])),
+            "obstacles[0].polygon",
+        ),
+        // A pentagram: convex turns, but it crosses itself.
+        (
+            with(
+                json!([{"polygon": [[50.0, 90.0], [73.5, 17.6], [11.9, 62.4], [88.1, 62.4], [26.5, 17.6]]}]),
+            ),
+            "obstacles[0].polygon",
+        ),
+        // Too few and too many vertices.
+        (
+            with(json!([{"polygon": [[0.0, 0.0], [10.0, 0.0]]}])),
+            "obstacles[0].polygon",
+        ),
+        (
+            with(json!([{"polygon": (0..33).map(|i| {
+                let a = f64::from(i) * std::f64::consts::TAU / 33.0;
+                json!([50.0 + 20.0 * a.cos(), 50.0 + 20.0 * a.sin()])
+            }).collect::<Vec<_>>()}])),
+            "obstacles[0].polygon",
+        ),
+        // Wholly outside the zone.
+        (
+            with(json!([{"polygon": [[110.0, 10.0], [130.0, 10.0], [120.0, 30.0]]}])),
+            "obstacles[0].polygon",
+        ),
+        // An unknown kind.
+        (
+            with(json!([{"polygon": square}, {"polygon": square, "kind": "wall"}])),
+            "obstacles[1].kind",
+        ),
+        // More than 64.
+        (
+            with(Value::Array(vec![json!({"polygon": square}); 65])),
+            "obstacles",
+        ),
+        // A source inside a building (one that crosses the zone's edge).
+        (
+            with(json!([{"polygon": [[-10.0, 40.0], [10.0, 40.0], [10.0, 60.0], [-10.0, 60.0]]}])),
+            "sources[0]",
+        ),
+        // A cone whose every ray meets a building before the zone.
+        (
+            with(
+                json!([{"polygon": [[-50.0, 90.0], [150.0, 90.0], [150.0, 100.5], [-50.0, 100.5]]}]),
+            ),
+            "sources[1]",
+        ),
+    ];
+    for (spec, field) in cases {
+        assert_validation(app.post_json("/v1/scenarios", &spec).await, field).await;
+    }
+    // A polygon across the zone's edge is valid.
+    let across =
+        with(json!([{"polygon": [[90.0, 10.0], [120.0, 10.0], [120.0, 30.0], [90.0, 30.0]]}]));
+    register(&app, &across).await;
+    // Non-numeric vertices are a 400 that names the field.
+    let res = app
+        .post_json("/v1/scenarios", &with(json!([{"polygon": [["a", 0.0]]}])))
+        .await;
+    assert!(res.status().is_client_error());
+}
+
+/// The built-in campus plans for a fleet of robots and drones.
+#[tokio::test]
+async fn site_campus_plans_a_mixed_fleet() {
+    let app = spawn_app().await;
+    let body = json!({
+        "sensors": [
+            {"id": "r1", "x": 45.0, "y": 145.0, "type": "robot"},
+            {"id": "r2", "x": 265.0, "y": 145.0, "type": "robot"},
+            {"id": "d1", "x": 215.0, "y": 95.0, "type": "drone"}
+        ],
+        "coordination": "iterated"
+    });
+    let plan = json_body(
+        app.post_json("/v1/scenarios/site-campus/plan", &body).await,
+        StatusCode::OK,
+    )
+    .await;
+    assert!(plan["expected_detections"].as_f64().unwrap() > 0.0);
+    // The drone over the office block is fine; a robot there is not.
+    let mut robot_on_office = body.clone();
+    robot_on_office["sensors"][2]["type"] = json!("robot");
+    assert_validation(
+        app.post_json("/v1/scenarios/site-campus/plan", &robot_on_office)
+            .await,
+        "sensors[2]",
+    )
+    .await;
+}
