@@ -6,12 +6,13 @@
 //! caller's choosing and runs the simulation in a task of its own:
 //! - `GET /` and `GET /live.js`: the page;
 //! - `GET /events`: Server-Sent Events, an `init` event (the zone, the `d_hat`
-//!   heat map, the sources and their cones, the no-go zones) and then a
-//!   `frame` event for every state (sensors, their plans, traces and
-//!   fields of view, targets by status, running metrics and their series,
-//!   the plan's certified gap, the planner's `explain` values). Every frame
-//!   holds the whole state, so a slow page skips frames without losing
-//!   anything;
+//!   heat map, the sources and their cones, the no-go zones, the obstacles)
+//!   and then a `frame` event for every state (sensors, their plans, traces
+//!   and fields of view, with obstacles the part of each field of view a
+//!   ground sensor sees, targets by status, running metrics and their
+//!   series, the plan's certified gap, the planner's `explain` values).
+//!   Every frame holds the whole state, so a slow page skips frames without
+//!   losing anything;
 //! - `GET /init` and `GET /frame`: the same as plain JSON;
 //! - `POST /control`: `{"action": "pause" | "resume" | "step"}` or
 //!   `{"action": "speed", "speed": steps_per_second}`.
@@ -41,6 +42,7 @@ use tokio::net::TcpListener;
 use tokio::sync::watch;
 use tokio::task::JoinHandle;
 use tokio::time::Instant;
+use vigil::obstacle::ObstacleKind;
 use vigil::planner::{EstimatorKind, Explain, PlanResponse};
 use vigil::scenario::{Cell, FovSpec};
 use vigil::stats::Stats;
@@ -51,6 +53,9 @@ use crate::experiment::{RunConfig, RunError};
 
 const PAGE: &str = include_str!("../static/live.html");
 const SCRIPT: &str = include_str!("../static/live.js");
+
+/// Rays of the outline of what a ground sensor sees (a frame sensor's `view`).
+pub const VIEW_RAYS: usize = 180;
 
 /// Slowest and fastest rates the page may set, steps per second.
 pub const SPEED_RANGE: (f64, f64) = (0.2, 200.0);
@@ -327,6 +332,16 @@ struct Init {
     sources: Vec<SourceOut>,
     /// Rectangles sensors may not enter (the scenario's `no_go`).
     no_go: Vec<RectOut>,
+    /// Buildings and screens, in the spec's order (empty when none).
+    obstacles: Vec<ObstacleOut>,
+}
+
+#[derive(Serialize)]
+struct ObstacleOut {
+    /// Vertices `[x, y]`, counter-clockwise.
+    polygon: Vec<[f64; 2]>,
+    /// `building` or `screen`.
+    kind: &'static str,
 }
 
 #[derive(Serialize)]
@@ -399,6 +414,18 @@ impl Init {
                     y1: r.y1,
                 })
                 .collect(),
+            obstacles: s
+                .obstacles
+                .list()
+                .iter()
+                .map(|o| ObstacleOut {
+                    polygon: o.polygon.vertices().iter().map(|v| [v.x, v.y]).collect(),
+                    kind: match o.kind {
+                        ObstacleKind::Building => "building",
+                        ObstacleKind::Screen => "screen",
+                    },
+                })
+                .collect(),
         }
     }
 }
@@ -437,6 +464,13 @@ struct SensorOut {
     /// `[col, row, …]`.
     path: Vec<i32>,
     expected: Option<f64>,
+    /// What the sensor sees, when obstacles can block its sight (a ground
+    /// type in a scenario with obstacles): the outline of
+    /// [`vigil::scenario::Scenario::view_outline`] with [`VIEW_RAYS`] rays,
+    /// `[x, y, x, y, …]` counter-clockwise, rounded to 0.01. Absent
+    /// otherwise: the sensor sees its whole field of view.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    view: Option<Vec<f64>>,
 }
 
 #[derive(Serialize)]
@@ -540,6 +574,15 @@ fn publish(
         .enumerate()
         .map(|(i, &c)| {
             let planned = plan.and_then(|p| p.plans.get(i));
+            let look = sim.scenario.look(sim.types[i], c);
+            let view = look.from.is_some().then(|| {
+                let round = |v: f64| (v * 100.0).round() / 100.0;
+                sim.scenario
+                    .view_outline(&look, VIEW_RAYS)
+                    .iter()
+                    .flat_map(|q| [round(q.x), round(q.y)])
+                    .collect()
+            });
             SensorOut {
                 col: c.col,
                 row: c.row,
@@ -555,6 +598,7 @@ fn publish(
                     })
                     .unwrap_or_default(),
                 expected: planned.map(|p| p.expected_detections),
+                view,
             }
         })
         .collect();

@@ -8,6 +8,12 @@ const canvas = $("zone");
 const ctx = canvas.getContext("2d");
 const MARGIN = 28;
 const STATUS_COLOUR = ["#14a02c", "#f08c00", "#8a5cc2", "#555"];
+// Obstacles: buildings opaque and dark, screens translucent green and
+// hatched (as in vigil-sim --svg).
+const BUILDING_FILL = "rgb(90,90,100)";
+const BUILDING_EDGE = "rgb(40,40,48)";
+const SCREEN_FILL = "rgba(50,160,60,0.5)";
+const SCREEN_HATCH = "rgba(20,100,30,0.8)";
 
 let init = null;
 let frame = null;
@@ -40,6 +46,7 @@ function setup(data) {
     `zone ${init.width}×${init.height}, cells of ${init.cell_size}` +
     (init.min_separation > 0 ? ` · sensors ≥ ${init.min_separation} cells apart` : "");
   $("prio-max").textContent = String(init.sensors);
+  $("legend-obstacles").hidden = !hasObstacles();
   const sel = $("explain-sensor");
   sel.innerHTML = "";
   for (let i = 0; i < init.sensors; i++) sel.add(new Option(String(i), String(i)));
@@ -63,6 +70,52 @@ function setup(data) {
     }
   }
   dirty = true;
+}
+
+const hasObstacles = () => Boolean(init && init.obstacles && init.obstacles.length);
+
+// A path through zone points given flat, [x0, y0, x1, y1, …], closed.
+function flatPath(xy) {
+  ctx.beginPath();
+  ctx.moveTo(px(xy[0]), py(xy[1]));
+  for (let k = 2; k < xy.length; k += 2) ctx.lineTo(px(xy[k]), py(xy[k + 1]));
+  ctx.closePath();
+}
+
+// Buildings filled dark; screens translucent green, hatched.
+function drawObstacles() {
+  let buildings = 0, screens = 0;
+  for (const o of init.obstacles || []) {
+    flatPath(o.polygon.flat());
+    if (o.kind === "screen") {
+      ctx.save();
+      ctx.fillStyle = SCREEN_FILL;
+      ctx.fill();
+      ctx.clip();
+      const xs = o.polygon.map(([x]) => px(x)), ys = o.polygon.map(([, y]) => py(y));
+      const x0 = Math.min(...xs), x1 = Math.max(...xs), y0 = Math.min(...ys), y1 = Math.max(...ys);
+      ctx.strokeStyle = SCREEN_HATCH;
+      ctx.lineWidth = 1;
+      ctx.beginPath();
+      for (let d = x0 - (y1 - y0); d < x1; d += 5) { ctx.moveTo(d, y1); ctx.lineTo(d + (y1 - y0), y0); }
+      ctx.stroke();
+      ctx.restore();
+      flatPath(o.polygon.flat());
+      ctx.strokeStyle = SCREEN_HATCH;
+      ctx.lineWidth = 1;
+      ctx.stroke();
+      screens++;
+    } else {
+      ctx.fillStyle = BUILDING_FILL;
+      ctx.fill();
+      ctx.strokeStyle = BUILDING_EDGE;
+      ctx.lineWidth = 1.5;
+      ctx.stroke();
+      buildings++;
+    }
+  }
+  canvas.dataset.buildingsDrawn = String(buildings);
+  canvas.dataset.screensDrawn = String(screens);
 }
 
 function drawStatic() {
@@ -108,13 +161,20 @@ function drawStatic() {
       ctx.setLineDash([]);
       ctx.restore();
     }
-    ctx.strokeStyle = "#000";
-    ctx.lineWidth = 2;
-    ctx.beginPath();
-    ctx.moveTo(x - 6, y - 6); ctx.lineTo(x + 6, y + 6);
-    ctx.moveTo(x + 6, y - 6); ctx.lineTo(x - 6, y + 6);
-    ctx.stroke();
+    if (!hasObstacles()) sourceMark(x, y);
   }
+  // Obstacles over the cones, under the sources' marks.
+  drawObstacles();
+  if (hasObstacles()) for (const s of init.sources) sourceMark(px(s.x), py(s.y));
+}
+
+function sourceMark(x, y) {
+  ctx.strokeStyle = "#000";
+  ctx.lineWidth = 2;
+  ctx.beginPath();
+  ctx.moveTo(x - 6, y - 6); ctx.lineTo(x + 6, y + 6);
+  ctx.moveTo(x + 6, y - 6); ctx.lineTo(x - 6, y + 6);
+  ctx.stroke();
 }
 
 function fovPath(col, row, fov) {
@@ -185,15 +245,44 @@ function draw() {
     for (let k = 2; k < tr.length; k += 2) ctx.lineTo(cellX(tr[k]), cellY(tr[k + 1]));
     ctx.stroke();
   });
-  // Fields of view.
+  // Fields of view. With obstacles, the part each sensor sees is shaded:
+  // a ground sensor's `view` outline (its field of view less what the
+  // obstacles hide, its whole field of view drawn dashed), an elevated
+  // one's whole field of view.
+  let views = 0;
   f.sensors.forEach((s) => {
-    fovPath(s.col, s.row, s.fov);
-    ctx.fillStyle = priorityColour(s.priority, 0.08);
-    ctx.fill();
-    ctx.strokeStyle = priorityColour(s.priority, 0.75);
-    ctx.lineWidth = 1;
-    ctx.stroke();
+    if (!hasObstacles()) {
+      fovPath(s.col, s.row, s.fov);
+      ctx.fillStyle = priorityColour(s.priority, 0.08);
+      ctx.fill();
+      ctx.strokeStyle = priorityColour(s.priority, 0.75);
+      ctx.lineWidth = 1;
+      ctx.stroke();
+      return;
+    }
+    if (s.view && s.view.length >= 6) {
+      flatPath(s.view);
+      ctx.fillStyle = priorityColour(s.priority, 0.3);
+      ctx.fill();
+      ctx.strokeStyle = priorityColour(s.priority, 0.8);
+      ctx.lineWidth = 1;
+      ctx.stroke();
+      fovPath(s.col, s.row, s.fov);
+      ctx.strokeStyle = priorityColour(s.priority, 0.45);
+      ctx.setLineDash([3, 3]);
+      ctx.stroke();
+      ctx.setLineDash([]);
+      views++;
+    } else {
+      fovPath(s.col, s.row, s.fov);
+      ctx.fillStyle = priorityColour(s.priority, 0.1);
+      ctx.fill();
+      ctx.strokeStyle = priorityColour(s.priority, 0.75);
+      ctx.lineWidth = 1;
+      ctx.stroke();
+    }
   });
+  canvas.dataset.viewsDrawn = String(views);
   // Plans.
   f.sensors.forEach((s) => {
     const p = s.path;
