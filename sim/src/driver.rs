@@ -227,6 +227,9 @@ pub struct Sim {
     /// Sent with plan requests when set, and kept by the local policies
     /// ([`Sim::local_moves`]).
     pub min_separation: Option<usize>,
+    /// Plans come from a model told no obstacles: a planned move the world
+    /// forbids becomes the legal move nearest to it instead of an error.
+    pub blind: bool,
 }
 
 impl Sim {
@@ -295,6 +298,7 @@ impl Sim {
             in_zone_before: HashSet::new(),
             window_start: None,
             min_separation: None,
+            blind: false,
         }
     }
 
@@ -632,10 +636,18 @@ impl Sim {
                     col: first.col,
                     row: first.row,
                 };
-                let legal = legal_moves(&self.scenario, c, ty).contains(&next);
-                legal
-                    .then_some(next)
-                    .ok_or_else(|| format!("illegal move {c:?} → {next:?}"))
+                let legal = legal_moves(&self.scenario, c, ty);
+                if legal.contains(&next) {
+                    return Ok(next);
+                }
+                if self.blind {
+                    // The first legal move at the least distance, in the
+                    // planner's tie order (`legal` is never empty: staying
+                    // is legal).
+                    let d = |m: &Cell| (m.col - next.col).pow(2) + (m.row - next.row).pow(2);
+                    return Ok(legal.iter().copied().min_by_key(d).unwrap_or(c));
+                }
+                Err(format!("illegal move {c:?} → {next:?}"))
             })
             .collect()
     }

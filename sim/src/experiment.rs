@@ -51,6 +51,12 @@ pub struct RunConfig {
     /// every step of the run, warm-up included) instead of stateless plan
     /// requests; the plans, and so the metrics, are the same.
     pub session: bool,
+    /// `scenario_id` is `scenario` told no obstacles (a control): plans
+    /// come from a model that sees through walls and flies targets through
+    /// buildings, and are judged in the world with them. A planned move
+    /// the world forbids (a ground sensor onto a building's cell) becomes
+    /// the legal move nearest to it ([`Sim::blind`]).
+    pub blind: bool,
 }
 
 impl RunConfig {
@@ -78,6 +84,7 @@ impl RunConfig {
             self.history,
         );
         sim.min_separation = self.min_separation;
+        sim.blind = self.blind;
         sim
     }
 }

@@ -123,6 +123,12 @@ struct Args {
     /// allowed legal move.
     #[arg(long, value_parser = clap::value_parser!(u8).range(0..=vigil::limits::MAX_MIN_SEPARATION as i64))]
     min_separation: Option<u8>,
+    /// A control for scenarios with obstacles: ask for plans of the same
+    /// scenario told no obstacles (registered without them), and judge them
+    /// in the world with them. A planned move the world forbids (a ground
+    /// sensor onto a building's cell) becomes the legal move nearest to it.
+    #[arg(long)]
+    blind: bool,
 }
 
 #[tokio::main]
@@ -162,6 +168,20 @@ async fn resolve(client: &Client, scenario: &str) -> Result<(String, Scenario), 
     Ok((info.id, local))
 }
 
+/// Registers `scenario` without its obstacles and gives its id.
+async fn blind_to_obstacles(client: &Client, scenario: &Scenario) -> Result<String, String> {
+    let spec = ScenarioSpec {
+        obstacles: None,
+        ..scenario.spec.clone()
+    };
+    let info = client.register(&spec).await.map_err(|e| e.to_string())?;
+    let info = client
+        .wait_ready(info, |_| {})
+        .await
+        .map_err(|e| e.to_string())?;
+    Ok(info.id)
+}
+
 async fn run(args: Args) -> Result<(), String> {
     let base = match &args.server {
         Some(url) => url.clone(),
@@ -189,7 +209,11 @@ async fn run(args: Args) -> Result<(), String> {
         start: args.start,
         min_separation: args.min_separation.map(usize::from),
         session: args.session,
+        blind: args.blind,
     };
+    if args.blind && args.experiment.is_some() {
+        return Err("--blind is a control of a single run; drop --experiment".into());
+    }
     let configs = match &args.experiment {
         Some(name) => {
             let unknown = || format!("unknown experiment `{name}` ({})", EXPERIMENTS.join(", "));
@@ -212,7 +236,13 @@ async fn run(args: Args) -> Result<(), String> {
             configs
         }
         None => {
-            let (id, scenario) = resolve(&client, &args.scenario).await?;
+            let (mut id, scenario) = resolve(&client, &args.scenario).await?;
+            if args.blind {
+                if !scenario.has_obstacles() {
+                    return Err(format!("--blind: {id} has no obstacles to be blind to"));
+                }
+                id = blind_to_obstacles(&client, &scenario).await?;
+            }
             let sensors = match &args.fleet {
                 Some(fleet) => fleet_size(fleet)
                     .ok_or_else(|| format!("--fleet {fleet:?}: expected NAME:COUNT,…"))?,

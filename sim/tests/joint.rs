@@ -26,6 +26,7 @@ fn config(policy: Policy, id: &str, scenario: &Scenario, steps: usize) -> RunCon
         start: Start::Grid,
         min_separation: None,
         session: false,
+        blind: false,
     }
 }
 

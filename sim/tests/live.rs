@@ -163,6 +163,7 @@ async fn live_view_in_headless_chromium() {
         start: Start::Grid,
         min_separation: None,
         session: false,
+        blind: false,
     };
     let listener = tokio::net::TcpListener::bind("127.0.0.1:0")
         .await
@@ -433,6 +434,7 @@ async fn live_view_draws_obstacles_and_views() {
         start: Start::Grid,
         min_separation: None,
         session: false,
+        blind: false,
     };
     let listener = tokio::net::TcpListener::bind("127.0.0.1:0")
         .await

@@ -363,6 +363,7 @@ async fn uncoordinated_planner_keeps_apart_in_closed_loop() {
         start: Start::Grid,
         min_separation: Some(d),
         session: false,
+        blind: false,
     };
     let mut means = Vec::new();
     for d in [0, 3] {

@@ -173,6 +173,7 @@ async fn end_to_end_over_http() {
             start: Start::Grid,
             min_separation: None,
             session: false,
+            blind: false,
         })
         .collect();
     let rows = run_all(&client, &configs, 7, 2, 4).await.expect("runs");
@@ -396,6 +397,7 @@ async fn fleets_move_within_their_speeds_around_no_go_zones() {
         start: Start::Grid,
         min_separation: None,
         session: false,
+        blind: false,
     };
     let (metrics, sim) = run_one(&client, &cfg, 5, true).await.expect("run");
     let sim = sim.expect("kept");
@@ -511,4 +513,72 @@ async fn the_client_waits_for_a_scenario_precomputed_as_a_job() {
     let sim = Sim::new(scenario, 2, Start::Grid, 1, 0);
     let req = sim.plan_request(Policy::Paper, Some(2));
     client.plan(&ready.id, &req).await.expect("planned");
+}
+
+/// `site-campus` in closed loop, planned by the occlusion-aware model and
+/// by the same model told no obstacles (`blind`): both runs keep every
+/// robot off the buildings' cells (the blind plans' forbidden moves are
+/// replaced), drones fly over them, and the world counts detections only
+/// along clear sight lines: the blind planner forecasts more than its
+/// plans detect.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn site_campus_runs_aware_and_blind() {
+    let base = spawn_local_server().await.expect("server");
+    let client = Client::new(&base);
+    let info = client.scenario("site-campus").await.expect("built-in");
+    let s = vigil::scenario::Scenario::new(info.spec.clone()).expect("valid");
+    let blind_spec = vigil::scenario::ScenarioSpec {
+        obstacles: None,
+        ..info.spec.clone()
+    };
+    let blind = client.register(&blind_spec).await.expect("registered");
+    let blind = client.wait_ready(blind, |_| {}).await.expect("ready");
+    let robot = s.type_index("robot").expect("robot");
+    let cfg = |id: &str, blind: bool| RunConfig {
+        label: if blind { "blind" } else { "aware" }.into(),
+        policy: Policy::Exact,
+        scenario_id: id.to_owned(),
+        scenario: s.clone(),
+        sensors: 6,
+        fleet: Some("drone:2,robot:4".into()),
+        steps: 30,
+        warmup: 20,
+        horizon: Some(2),
+        history: 4,
+        start: Start::Grid,
+        min_separation: None,
+        session: false,
+        blind,
+    };
+    let mut calibration = Vec::new();
+    for (id, blind) in [(info.id.as_str(), false), (blind.id.as_str(), true)] {
+        let (metrics, sim) = run_one(&client, &cfg(id, blind), 3, true)
+            .await
+            .expect("run");
+        let sim = sim.expect("kept");
+        assert_fleet_legal(&sim);
+        for (trace, &ty) in sim.trace.iter().zip(&sim.types) {
+            for &c in trace {
+                assert_eq!(
+                    ty == robot && s.obstacles.in_building(s.centre(c)),
+                    false,
+                    "a robot on a building's cell {c:?}"
+                );
+            }
+        }
+        assert!(metrics.ad > 0.0);
+        calibration.push(
+            metrics
+                .calibration
+                .expect("planner runs report calibration"),
+        );
+    }
+    // Realised over forecast detections: the blind model counts targets
+    // behind walls, so it forecasts more than its plans detect.
+    assert!(
+        calibration[1] < calibration[0],
+        "aware {:.3}, blind {:.3}",
+        calibration[0],
+        calibration[1]
+    );
 }
