@@ -3,9 +3,11 @@
 
 One Stone Soup run per (platform count, manager): targets from
 `VigilGroundTruthSimulator` (the scenario's sources, the same seed for every
-manager, starting from the stationary population), N platforms with a
-`VigilFOVSensor` of the scenario's coverage on a `LatticeActionableMovable`
-(legal moves: king moves of the sensor's speed inside the zone), and an
+manager, starting from the stationary population; targets end at buildings),
+N platforms of the type `default` with a `VigilFOVSensor` of the scenario's
+coverage (sight lines blocked by the scenario's obstacles) on a
+`LatticeActionableMovable` (legal moves: king moves of the sensor's speed
+inside the zone, off no-go ground and buildings), and an
 ideal tracker (tracks keyed by the detected target's identity, position from
 the measurement, velocity from the ground truth; a track is dropped after
 16 steps without a detection). Each step: platforms act, sensors measure,
@@ -73,7 +75,8 @@ class ExpectedDetectionsReward(RewardFunction):
     """Expected detections at ``metric_time`` of the tracks (moved at their
     velocities), by the platforms of the configuration after their moves:
     per track ``1 - prod(1 - p_detect)`` over the platforms' sensors that
-    would hold it. Platforms not in the configuration are ignored."""
+    would hold it (in view, and on a clear sight line: ``covers_at``).
+    Platforms not in the configuration are ignored."""
 
     position_mapping: Sequence[int] = Property(default=(0, 2))
     velocity_mapping: Sequence[int] = Property(default=(1, 3))
@@ -162,19 +165,20 @@ class IdealTracker:
         return set(self.tracks.values())
 
 
-def grid_starts(vmap: VigilMap, n: int) -> list[tuple[int, int]]:
-    """N free cells spread over the zone on a near-square grid (as vigil-sim's
-    `--start grid`): each at the centre of its share, or the nearest free cell."""
+def grid_starts(vmap: VigilMap, n: int, type_name: str = "default") -> list[tuple[int, int]]:
+    """N cells free for ``type_name`` spread over the zone on a near-square
+    grid (as vigil-sim's `--start grid`): each at the centre of its share, or
+    the nearest free cell."""
     cols = max(1, math.ceil(math.sqrt(n)))
     rows = math.ceil(n / cols)
-    free = vmap.free_cells()
+    free = vmap.free_cells(type_name)
     out = []
     for i in range(n):
         c, r = i % cols, i // cols
         x = (c + 0.5) * vmap.width / cols + vmap.origin[0]
         y = (r + 0.5) * vmap.height / rows + vmap.origin[1]
         cell = vmap.cell_of((x, y))
-        if not vmap.is_free(cell):
+        if not vmap.is_free(cell, type_name):
             cell = min(free, key=lambda f: (max(abs(f[0] - cell[0]), abs(f[1] - cell[1])), f[1], f[0]))
         out.append(cell)
     return out
@@ -235,7 +239,8 @@ def run(name: str, n: int, truth, vmap: VigilMap, args, vigil: Vigil) -> dict:
                 missing = [p.id for p in platforms if not config.get(p)]
                 if missing:
                     raise RuntimeError(f"{name}: no action for platforms {missing}")
-                check_actions(config, vmap, speeds)  # IllegalMoveError on any illegal move
+                # IllegalMoveError on any illegal move of the type.
+                check_actions(config, vmap, speeds, types="default")
                 checked += len(platforms)
                 for actionable, actions in config.items():
                     actionable.add_actions(list(actions))

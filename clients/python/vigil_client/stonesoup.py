@@ -13,17 +13,34 @@ What it provides
   session) to Vigil, and returns ``[{platform: [action]}]``: per platform the
   move to the first cell of its plan, each checked to be legal.
 * :class:`VigilMap`, the mapping between Stone Soup coordinates and Vigil's
-  zone and cells, with the legality of moves (:meth:`VigilMap.check_move`).
+  zone and cells, with the legality of moves per sensor type
+  (:meth:`VigilMap.check_move`) and the scenario's obstacles
+  (:class:`Obstacle`, :meth:`VigilMap.clear`).
 * :class:`LatticeActionableMovable`, a
   :class:`~stonesoup.movable.max_speed.MaxSpeedActionableMovable` whose
   action generator yields exactly the legal moves (king moves of at most the
-  sensor type's speed through free cells), so that Stone Soup's own
-  managers choose from the same moves as Vigil.
-* :class:`VigilFOVSensor`, a Stone Soup sensor with Vigil's field of view,
-  and :func:`make_platform`, a platform of either kind with an explicit id.
+  sensor type's speed through cells free for the type), so that Stone
+  Soup's own managers choose from the same moves as Vigil.
+* :class:`VigilFOVSensor`, a Stone Soup sensor with Vigil's field of view
+  and sight lines, and :func:`make_platform`, a platform of either kind with
+  an explicit id.
 * :class:`VigilGroundTruthSimulator`, ground truth that follows Vigil's
   target model (Stone Soup has no simulator of targets born at fixed points
-  outside the area that fly straight and leave).
+  outside the area that fly straight and leave, or end at a building).
+
+Obstacles
+---------
+A scenario's ``obstacles`` are convex polygons of kind ``building`` or
+``screen``. Both block the sight of ground sensor types (a look detects a
+target only if the open segment from the sensor's cell centre to the target
+meets no obstacle's interior; touching an edge or a vertex does not block);
+``elevated`` types (``sensor_types.NAME.elevated``, e.g. a drone) see over
+them. A building also ends the flight of a target that enters it, and keeps
+ground types off every cell whose centre it holds (edges included), like
+``no_go``; elevated types may stand on and cross those cells. Every class
+here follows these rules: :meth:`VigilMap.is_free` and the moves take the
+sensor type, :class:`VigilFOVSensor` checks sight lines and
+:class:`VigilGroundTruthSimulator` stops targets at buildings.
 
 Coordinates and cells
 ---------------------
@@ -49,7 +66,8 @@ What a Stone Soup sensor must be for Vigil's model to apply
 Vigil plans for sensors whose *look* at a step, from the cell centre where
 the platform stands, detects every target inside the sensor type's field of
 view independently with probability ``p_detect`` and nothing outside it.
-The platform's sensor must therefore have:
+The platform's sensor must therefore have (for a ground type with
+obstacles, only along clear sight lines, see *Obstacles*):
 
 * for a ``square`` field of view of ``half_width`` h: coverage of the
   axis-aligned closed square ``|dx| <= h and |dy| <= h`` around the
@@ -110,9 +128,11 @@ except ImportError as err:  # pragma: no cover - only without the extra
 from . import Vigil
 
 __all__ = [
+    "OBSTACLE_KINDS",
     "IllegalMoveError",
     "LatticeActionableMovable",
     "LatticeMoveActionGenerator",
+    "Obstacle",
     "SensorType",
     "VigilFOVSensor",
     "VigilGroundTruthSimulator",
@@ -135,10 +155,14 @@ class IllegalMoveError(ValueError):
 
 @dataclass(frozen=True)
 class SensorType:
-    """One of a scenario's sensor types: field of view, speed, ``p_detect``.
+    """One of a scenario's sensor types: field of view, speed, ``p_detect``
+    and whether it is ``elevated``.
 
     ``shape`` is ``"square"`` (``size`` is the half-width) or ``"circle"``
     (``size`` is the radius); ``speed`` is in king moves (cells) per step.
+    An elevated type (a drone) sees over every obstacle and may stand on
+    and cross building cells; a ground type (``elevated`` false, always so
+    for ``default``) does neither.
     """
 
     name: str
@@ -146,9 +170,12 @@ class SensorType:
     size: float
     speed: int
     p_detect: float
+    elevated: bool = False
 
     def covers(self, centre: Sequence[float], point: Sequence[float]) -> bool:
-        """True when the closed field of view centred at ``centre`` holds ``point``."""
+        """True when the closed field of view centred at ``centre`` holds
+        ``point`` (the field of view only: obstacles are the map's, see
+        :meth:`VigilMap.sees`)."""
         return _in_view(self.shape, self.size, centre, point)
 
 
@@ -170,13 +197,164 @@ def _fov(fov: Mapping[str, Any]) -> tuple[str, float]:
     raise ValueError(f"unknown field of view shape {shape!r}")
 
 
+OBSTACLE_KINDS = ("building", "screen")
+"""The obstacle kinds: a ``building`` blocks sight, ends the flight of a
+target that enters it and keeps ground sensors off the cells whose centres
+it holds; a ``screen`` (trees, a hedge, smoke) blocks sight only."""
+
+
+class Obstacle:
+    """One of a scenario's obstacles: a convex polygon in Vigil's
+    coordinates and its ``kind`` (``"building"`` or ``"screen"``).
+
+    ``vertices`` are given in either order around the polygon (as in the
+    spec's ``polygon``) and kept counter-clockwise; the polygon must be
+    convex, with no repeated vertex and no three consecutive vertices
+    collinear (``ValueError`` otherwise). Its interior is the intersection
+    of the open half-planes left of its edges.
+    """
+
+    __slots__ = ("vertices", "kind", "bbox", "eps", "_edges")
+
+    def __init__(self, vertices: Sequence[Sequence[float]], kind: str = "building"):
+        if kind not in OBSTACLE_KINDS:
+            raise ValueError(f"unknown obstacle kind {kind!r}: 'building' or 'screen'")
+        points = [(float(v[0]), float(v[1])) for v in vertices]
+        n = len(points)
+        if n < 3:
+            raise ValueError(f"a polygon needs at least 3 vertices, got {n}")
+        if not all(math.isfinite(c) for v in points for c in v):
+            raise ValueError("the vertices must be pairs of finite numbers")
+        if len(set(points)) != n:
+            raise ValueError("a vertex is repeated")
+        scale = max(1.0, max(max(abs(x), abs(y)) for x, y in points))
+        sign, turning = 0.0, 0.0
+        for i in range(n):
+            (ax, ay), (bx, by), (cx, cy) = points[i], points[(i + 1) % n], points[(i + 2) % n]
+            ux, uy, vx, vy = bx - ax, by - ay, cx - bx, cy - by
+            cross = ux * vy - uy * vx
+            if abs(cross) <= 1e-12 * math.hypot(ux, uy) * math.hypot(vx, vy) + 1e-15 * scale * scale:
+                raise ValueError(f"vertices {i}, {(i + 1) % n} and {(i + 2) % n} are collinear")
+            if sign != 0.0 and math.copysign(1.0, cross) != sign:
+                raise ValueError(f"the polygon is not convex (it turns both ways at vertex {(i + 1) % n})")
+            sign = math.copysign(1.0, cross)
+            turning += math.atan2(cross, ux * vx + uy * vy)
+        if round(abs(turning) / math.tau) != 1:
+            raise ValueError("the polygon intersects itself")
+        if sign < 0:
+            points.reverse()
+        self.vertices: tuple[tuple[float, float], ...] = tuple(points)
+        """The vertices, counter-clockwise."""
+        self.kind = kind
+        xs, ys = [x for x, _ in points], [y for _, y in points]
+        self.bbox = (min(xs), min(ys), max(xs), max(ys))
+        """``(x0, y0, x1, y1)``, the bounding box."""
+        self.eps = 1e-9 * scale
+        """Tolerance of :meth:`contains_closed` (as the server's)."""
+        # Edge i from vertex i to i + 1: (a, b - a, |b - a|).
+        self._edges = tuple(
+            (a[0], a[1], b[0] - a[0], b[1] - a[1], math.hypot(b[0] - a[0], b[1] - a[1]))
+            for a, b in zip(points, points[1:] + points[:1], strict=True)
+        )
+
+    @classmethod
+    def from_spec(cls, spec: Mapping[str, Any]) -> Obstacle:
+        """From one of the spec's ``obstacles``: ``{"polygon": [[x, y], ...],
+        "kind": "building" | "screen"}`` (``kind`` ``building`` by default)."""
+        return cls(spec["polygon"], spec.get("kind") or "building")
+
+    @property
+    def is_building(self) -> bool:
+        return self.kind == "building"
+
+    def __repr__(self) -> str:
+        return f"Obstacle({list(self.vertices)!r}, kind={self.kind!r})"
+
+    def contains_open(self, xy: Sequence[float]) -> bool:
+        """True when Vigil ``(x, y)`` lies in the open interior."""
+        x, y = float(xy[0]), float(xy[1])
+        return all(ex * (y - ay) - ey * (x - ax) > 0.0 for ax, ay, ex, ey, _ in self._edges)
+
+    def contains_closed(self, xy: Sequence[float]) -> bool:
+        """True when Vigil ``(x, y)`` lies in the closed polygon, within
+        :attr:`eps` of its edges (a point on an edge, up to rounding, is
+        inside)."""
+        x, y = float(xy[0]), float(xy[1])
+        return all(
+            ex * (y - ay) - ey * (x - ax) >= -self.eps * length
+            for ax, ay, ex, ey, length in self._edges
+        )
+
+    def line_interior(self, o: Sequence[float], d: Sequence[float]) -> tuple[float, float] | None:
+        """The open parameter interval ``(t0, t1)`` of the line ``o + t d``
+        inside the open interior (``t0 < t1``, either may be infinite), or
+        None when the line misses it or only touches its boundary.
+
+        Cyrus–Beck: the interior is the intersection of the edges' open
+        half-planes, so the line is inside on the intersection of one open
+        interval of ``t`` per edge. Exact up to the rounding of one cross
+        product per edge (exact for integer coordinates)."""
+        ox, oy, dx, dy = float(o[0]), float(o[1]), float(d[0]), float(d[1])
+        t0, t1 = -math.inf, math.inf
+        for ax, ay, ex, ey, _ in self._edges:
+            # Left of the edge: cross(e, o + t d - a) = num + t den > 0.
+            num = ex * (oy - ay) - ey * (ox - ax)
+            den = ex * dy - ey * dx
+            if den > 0.0:
+                t0 = max(t0, -num / den)
+            elif den < 0.0:
+                t1 = min(t1, -num / den)
+            elif num <= 0.0:
+                return None  # parallel to the edge, on it or outside
+            if t0 >= t1:
+                return None
+        return t0, t1
+
+    def blocks(self, p: Sequence[float], q: Sequence[float]) -> bool:
+        """True when the open segment from Vigil ``p`` to ``q`` meets the
+        open interior (touching an edge or a vertex does not block; from a
+        point inside, every segment is blocked, even to itself)."""
+        px, py, qx, qy = float(p[0]), float(p[1]), float(q[0]), float(q[1])
+        x0, y0, x1, y1 = self.bbox
+        if max(px, qx) <= x0 or min(px, qx) >= x1 or max(py, qy) <= y0 or min(py, qy) >= y1:
+            return False  # the closed segment's box meets no interior point
+        span = self.line_interior((px, py), (qx - px, qy - py))
+        return span is not None and max(span[0], 0.0) < min(span[1], 1.0)
+
+    def stop(self, o: Sequence[float], u: Sequence[float]) -> float:
+        """How far along the ray ``o + t u`` (``t >= 0``) it first enters the
+        open interior (0 from inside), or infinity; ``t`` in units of
+        ``|u|``."""
+        span = self.line_interior(o, u)
+        if span is None or span[1] <= 0.0:
+            return math.inf
+        return max(span[0], 0.0)
+
+
+def _obstacles(spec: Mapping[str, Any]) -> list[Obstacle]:
+    out = []
+    for i, o in enumerate(spec.get("obstacles") or []):
+        try:
+            out.append(Obstacle.from_spec(o))
+        except (KeyError, TypeError, ValueError) as e:
+            raise ValueError(f"obstacles[{i}]: {e}") from None
+    return out
+
+
 class VigilMap:
-    """Vigil's zone and lattice in Stone Soup coordinates.
+    """Vigil's zone, lattice and obstacles in Stone Soup coordinates.
 
     Built from a scenario spec (the JSON of ``GET /v1/scenarios/{id}``'s
     ``spec``). Stone Soup coordinates are Vigil's plus ``origin``. Cells are
-    ``(col, row)`` tuples; a cell is free when it is on the lattice and its
-    centre is in no ``no_go`` rectangle (edges included).
+    ``(col, row)`` tuples. A cell is free for a sensor type when it is on
+    the lattice, its centre is in no ``no_go`` rectangle (edges included)
+    and, for a ground type (not ``elevated``; ``default`` never is), its
+    centre is in no building (the closed polygon, within a rounding
+    tolerance: a centre on an edge is inside). Screens never block cells.
+    The cell methods take a ``type_name``, ``"default"`` when left out.
+
+    ``obstacles`` (:class:`Obstacle`, in Vigil's coordinates) block ground
+    sensors' sight lines: :meth:`clear` and :meth:`sees`.
     """
 
     def __init__(self, spec: Mapping[str, Any], origin: Sequence[float] = (0.0, 0.0)):
@@ -191,6 +369,8 @@ class VigilMap:
             (float(r["x0"]), float(r["y0"]), float(r["x1"]), float(r["y1"]))
             for r in spec.get("no_go") or []
         ]
+        self.obstacles: list[Obstacle] = _obstacles(spec)
+        """The buildings and screens, in the spec's order (Vigil coordinates)."""
         shape, size = _fov(spec["fov"])
         self.sensor_types = {
             "default": SensorType(
@@ -204,8 +384,24 @@ class VigilMap:
         for name, t in (spec.get("sensor_types") or {}).items():
             shape, size = _fov(t["fov"])
             self.sensor_types[name] = SensorType(
-                name, shape, size, int(t.get("speed") or 1), float(t.get("p_detect") or 1.0)
+                name, shape, size, int(t.get("speed") or 1), float(t.get("p_detect") or 1.0),
+                bool(t.get("elevated") or False),
             )
+        self._building_cells = frozenset(self._cells_in_buildings())
+
+    def _cells_in_buildings(self) -> Iterator[Cell]:
+        c = self.cell_size
+        for o in self.obstacles:
+            if not o.is_building:
+                continue
+            x0, y0, x1, y1 = o.bbox
+            # Only the cells whose centres may lie in the bounding box.
+            for row in range(max(0, math.floor((y0 - o.eps) / c - 1)),
+                             min(self.rows, math.ceil((y1 + o.eps) / c + 1))):
+                for col in range(max(0, math.floor((x0 - o.eps) / c - 1)),
+                                 min(self.cols, math.ceil((x1 + o.eps) / c + 1))):
+                    if o.contains_closed(((col + 0.5) * c, (row + 0.5) * c)):
+                        yield col, row
 
     def sensor_type(self, name: str = "default") -> SensorType:
         """The sensor type ``name``; ``KeyError`` naming the known ones otherwise."""
@@ -253,23 +449,51 @@ class VigilMap:
     def on_lattice(self, cell: Cell) -> bool:
         return 0 <= cell[0] < self.cols and 0 <= cell[1] < self.rows
 
-    def is_free(self, cell: Cell) -> bool:
-        """On the lattice and not blocked by a no-go rectangle."""
-        if not self.on_lattice(cell):
-            return False
-        x, y = (cell[0] + 0.5) * self.cell_size, (cell[1] + 0.5) * self.cell_size
-        return not any(x0 <= x <= x1 and y0 <= y <= y1 for x0, y0, x1, y1 in self.no_go)
+    # -- where sensors may stand
 
-    def free_cells(self) -> list[Cell]:
-        """Every free cell, row by row from the south-west."""
+    def in_building(self, xy: Sequence[float]) -> bool:
+        """True when Stone Soup ``(x, y)`` lies in a building (closed, within
+        the rounding tolerance of its edges)."""
+        v = self.to_vigil(xy)
+        return any(o.is_building and o.contains_closed(v) for o in self.obstacles)
+
+    def blocked_reason(self, cell: Cell, type_name: str = "default") -> str | None:
+        """Why a sensor of type ``type_name`` may not stand on ``cell``
+        (off the lattice, no-go ground, or a building for a ground type), or
+        None when it may."""
+        elevated = self.sensor_type(type_name).elevated
+        if not self.on_lattice(cell):
+            return "off the lattice"
+        x, y = (cell[0] + 0.5) * self.cell_size, (cell[1] + 0.5) * self.cell_size
+        if any(x0 <= x <= x1 and y0 <= y <= y1 for x0, y0, x1, y1 in self.no_go):
+            return "no-go ground"
+        if not elevated and cell in self._building_cells:
+            return f"a building (no ground sensor, as type {type_name!r} is, may stand there)"
+        return None
+
+    def is_free(self, cell: Cell, type_name: str = "default") -> bool:
+        """On the lattice, not blocked by a no-go rectangle, and for a ground
+        type ``type_name`` its centre in no building."""
+        return self.blocked_reason(cell, type_name) is None
+
+    def free_cells(self, type_name: str = "default") -> list[Cell]:
+        """Every cell free for ``type_name``, row by row from the south-west."""
         return [
-            (c, r) for r in range(self.rows) for c in range(self.cols) if self.is_free((c, r))
+            (c, r)
+            for r in range(self.rows)
+            for c in range(self.cols)
+            if self.is_free((c, r), type_name)
         ]
 
-    def reachable(self, cell: Cell, speed: int) -> dict[Cell, int]:
-        """The cells a sensor of ``speed`` (king moves per step) at free
-        ``cell`` can end a step on, each with the fewest moves it takes:
-        every cell on the way and at the end free. Holds ``cell`` (0 moves)."""
+    def reachable(
+        self, cell: Cell, speed: int | None = None, type_name: str = "default"
+    ) -> dict[Cell, int]:
+        """The cells a sensor of type ``type_name`` and ``speed`` (king moves
+        per step; the type's by default) at free ``cell`` can end a step on,
+        each with the fewest moves it takes: every cell on the way and at the
+        end free for the type. Holds ``cell`` (0 moves)."""
+        if speed is None:
+            speed = self.sensor_type(type_name).speed
         seen = {cell: 0}
         frontier = [cell]
         for k in range(1, speed + 1):
@@ -277,35 +501,75 @@ class VigilMap:
             for c, r in frontier:
                 for dc, dr in _KING:
                     n = (c + dc, r + dr)
-                    if n not in seen and self.is_free(n):
+                    if n not in seen and self.is_free(n, type_name):
                         seen[n] = k
                         nxt.append(n)
             frontier = nxt
         return seen
 
-    def check_move(self, start: Sequence[float], end: Sequence[float], speed: int) -> Cell:
-        """Checks that a platform at Stone Soup ``start`` may move to ``end``
-        in one step with ``speed`` king moves: ``start`` in a free cell,
-        ``end`` the centre of a free cell reachable in at most ``speed`` king
-        moves through free cells. Returns the end cell; raises
+    def check_move(
+        self,
+        start: Sequence[float],
+        end: Sequence[float],
+        speed: int | None = None,
+        type_name: str = "default",
+    ) -> Cell:
+        """Checks that a platform of type ``type_name`` at Stone Soup
+        ``start`` may move to ``end`` in one step with ``speed`` king moves
+        (the type's by default): ``start`` in a cell free for the type,
+        ``end`` the centre of such a cell reachable in at most ``speed`` king
+        moves through such cells. Returns the end cell; raises
         :class:`IllegalMoveError` saying what is wrong otherwise."""
+        if speed is None:
+            speed = self.sensor_type(type_name).speed
         try:
             a = self.cell_of(start)
             b = self.cell_of(end)
         except ValueError as e:
             raise IllegalMoveError(f"move {tuple(start)} -> {tuple(end)}: {e}") from None
-        if not self.is_free(a):
-            raise IllegalMoveError(f"the platform stands on no-go ground, cell {a}")
-        if not self.is_free(b):
-            raise IllegalMoveError(f"move to no-go ground, cell {b}")
+        why = self.blocked_reason(a, type_name)
+        if why is not None:
+            raise IllegalMoveError(f"the platform stands on {why}, cell {a}")
+        why = self.blocked_reason(b, type_name)
+        if why is not None:
+            raise IllegalMoveError(f"move to {why}, cell {b}")
         if not np.allclose(self.centre(b), np.asarray(end[:2], dtype=float), atol=1e-6):
             raise IllegalMoveError(f"move to {tuple(end)}, not the centre of cell {b}")
-        if b not in self.reachable(a, speed):
+        if b not in self.reachable(a, speed, type_name):
             raise IllegalMoveError(
                 f"move from cell {a} to cell {b} takes more than {speed} king move(s) "
-                "through free cells"
+                f"through cells free for type {type_name!r}"
             )
         return b
+
+    # -- what sensors see
+
+    def clear(self, p: Sequence[float], q: Sequence[float]) -> bool:
+        """True when the open segment from Stone Soup ``p`` to ``q`` meets no
+        obstacle's interior (buildings and screens alike; a segment that
+        only touches an edge or a vertex is clear)."""
+        vp, vq = self.to_vigil(p), self.to_vigil(q)
+        return not any(o.blocks(vp, vq) for o in self.obstacles)
+
+    def sees(self, type_name: str, centre: Sequence[float], point: Sequence[float]) -> bool:
+        """True when a look of type ``type_name`` from Stone Soup ``centre``
+        can detect a target at ``point``: inside its field of view and the
+        zone, and (for a ground type) on a clear sight line."""
+        t = self.sensor_type(type_name)
+        return (
+            t.covers(centre, point)
+            and self.in_zone(point)
+            and (t.elevated or self.clear(centre, point))
+        )
+
+    def flight_stop(self, source: Sequence[float], direction: Sequence[float]) -> float:
+        """How far a target flying from Vigil ``source`` along ``direction``
+        (in units of its length) goes before it first enters a building's
+        interior (0 from inside one), or infinity: its flight ends there."""
+        return min(
+            (o.stop(source, direction) for o in self.obstacles if o.is_building),
+            default=math.inf,
+        )
 
 
 def _xy(position) -> np.ndarray:
@@ -318,16 +582,19 @@ def _xy(position) -> np.ndarray:
 
 
 class LatticeMoveActionGenerator(MaxSpeedPositionActionGenerator):
-    """The legal moves of a Vigil sensor: staying, or going to the centre of
-    any free cell within ``speed_cells`` king moves through free cells.
+    """The legal moves of a Vigil sensor of type ``type_name``: staying, or
+    going to the centre of any cell free for the type within
+    ``speed_cells`` king moves through such cells (a ground type never
+    stands on or crosses a building's cell; an elevated one may).
     ``__contains__`` and ``action_from_value`` accept exactly those."""
 
     vigil_map: VigilMap = Property(default=None, doc="The zone and its cells.")
     speed_cells: int = Property(default=1, doc="King moves per step.")
+    type_name: str = Property(default="default", doc="The Vigil sensor type that moves.")
 
     def _cells(self):
         start = self.vigil_map.cell_of(_xy(self.current_value))
-        return self.vigil_map.reachable(start, self.speed_cells)
+        return self.vigil_map.reachable(start, self.speed_cells, self.type_name)
 
     def _target(self, cell: Cell) -> StateVector:
         value = np.array(self.current_value, dtype=float)
@@ -338,7 +605,9 @@ class LatticeMoveActionGenerator(MaxSpeedPositionActionGenerator):
         if isinstance(item, MovePositionAction):
             item = item.target_value
         try:
-            self.vigil_map.check_move(_xy(self.current_value), _xy(item), self.speed_cells)
+            self.vigil_map.check_move(
+                _xy(self.current_value), _xy(item), self.speed_cells, self.type_name
+            )
         except IllegalMoveError:
             return False
         return True
@@ -359,21 +628,25 @@ class LatticeMoveActionGenerator(MaxSpeedPositionActionGenerator):
 class LatticeActionableMovable(MaxSpeedActionableMovable):
     """A :class:`MaxSpeedActionableMovable` whose actions are a Vigil sensor's
     legal moves (see :class:`LatticeMoveActionGenerator`). Give it
-    ``vigil_map`` and ``speed_cells`` (the sensor type's speed)."""
+    ``vigil_map``, ``speed_cells`` (the sensor type's speed) and
+    ``type_name`` (the sensor type: whether it may cross buildings)."""
 
     generator = LatticeMoveActionGenerator
     _generator_kwargs = MaxSpeedActionableMovable._generator_kwargs | {
         "vigil_map",
         "speed_cells",
+        "type_name",
     }
 
     vigil_map: VigilMap = Property(default=None, doc="The zone and its cells.")
     speed_cells: int = Property(default=1, doc="King moves per step.")
+    type_name: str = Property(default="default", doc="The Vigil sensor type that moves.")
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         if self.vigil_map is None:
             raise ValueError("LatticeActionableMovable needs a vigil_map")
+        self.vigil_map.sensor_type(self.type_name)  # KeyError for an unknown type
 
 
 # ---------------------------------------------------------------------------
@@ -387,7 +660,14 @@ class VigilFOVSensor(SimpleSensor):
     ``vigil_map`` is given, with probability ``p_detect``, independently;
     nothing outside. Measurements are ``(x, y)`` with Gaussian noise of
     ``noise_covar`` (``mapping`` picks x and y from the target state).
-    Detection draws use ``seed`` (or numpy's global state)."""
+    Detection draws use ``seed`` (or numpy's global state).
+
+    With a ``vigil_map`` whose scenario has obstacles, a ground sensor
+    (``elevated`` false) detects a target only along a clear sight line:
+    the open segment from the platform to the target meets no obstacle's
+    interior (buildings and screens; a line that only touches an edge or a
+    vertex is clear, and a sensor inside a screen sees nothing). An
+    ``elevated`` sensor sees over every obstacle."""
 
     shape: str = Property(default="square", doc="'square' or 'circle'.")
     size: float = Property(default=1.0, doc="Half-width of a square, radius of a circle.")
@@ -397,14 +677,20 @@ class VigilFOVSensor(SimpleSensor):
     noise_covar: CovarianceMatrix = Property(
         default=None, doc="Measurement noise covariance (2x2); identity by default."
     )
-    vigil_map: VigilMap = Property(default=None, doc="Clips the view to the zone when given.")
+    vigil_map: VigilMap = Property(
+        default=None,
+        doc="Clips the view to the zone, and its obstacles block sight lines, when given.",
+    )
+    elevated: bool = Property(default=False, doc="Sees over every obstacle (a drone).")
 
     @classmethod
     def for_type(cls, vigil_map: VigilMap, type_name: str = "default", **kwargs):
-        """The sensor of the scenario's type ``type_name``, clipped to the zone."""
+        """The sensor of the scenario's type ``type_name``, clipped to the
+        zone, its sight blocked by the obstacles unless the type is elevated."""
         t = vigil_map.sensor_type(type_name)
         return cls(
-            shape=t.shape, size=t.size, p_detect=t.p_detect, vigil_map=vigil_map, **kwargs
+            shape=t.shape, size=t.size, p_detect=t.p_detect, vigil_map=vigil_map,
+            elevated=t.elevated, **kwargs
         )
 
     @property
@@ -416,9 +702,15 @@ class VigilFOVSensor(SimpleSensor):
 
     def covers_at(self, centre: Sequence[float], point: Sequence[float]) -> bool:
         """True when the sensor standing at Stone Soup ``centre`` has ``point``
-        (Stone Soup ``(x, y)``) in view."""
-        inside = _in_view(self.shape, self.size, centre, point)
-        return inside and (self.vigil_map is None or self.vigil_map.in_zone(point))
+        (Stone Soup ``(x, y)``) in view: in its field of view, in the zone
+        and on a clear sight line (see the class)."""
+        if not _in_view(self.shape, self.size, centre, point):
+            return False
+        if self.vigil_map is None:
+            return True
+        return self.vigil_map.in_zone(point) and (
+            self.elevated or self.vigil_map.clear(centre, point)
+        )
 
     def is_detectable(self, state, measurement_model=None) -> bool:
         """In view (before the ``p_detect`` draw of :meth:`measure`)."""
@@ -466,40 +758,67 @@ def make_platform(
     sensor_kwargs: Mapping[str, Any] | None = None,
 ) -> Platform:
     """A platform with id ``platform_id`` at Stone Soup ``position`` (snapped
-    to its cell's centre), with a :class:`LatticeActionableMovable` of the
-    type's speed and one :class:`VigilFOVSensor` of the type. Its
-    ``max_speed`` covers the longest legal move (``speed`` diagonal cells in
-    ``time_step``), so ``action_from_value`` accepts every legal move."""
+    to its cell's centre, which must be free for the type: ``ValueError``
+    otherwise), with a :class:`LatticeActionableMovable` of the type's speed
+    and one :class:`VigilFOVSensor` of the type. Its ``max_speed`` covers the
+    longest legal move (``speed`` diagonal cells in ``time_step``), so
+    ``action_from_value`` accepts every legal move."""
     t = vigil_map.sensor_type(type_name)
-    centre = vigil_map.centre(vigil_map.cell_of(position))
+    cell = vigil_map.cell_of(position)
+    why = vigil_map.blocked_reason(cell, type_name)
+    if why is not None:
+        raise ValueError(f"platform {platform_id!r} would stand on {why}, cell {cell}")
+    centre = vigil_map.centre(cell)
     max_speed = t.speed * vigil_map.cell_size * math.sqrt(2.0) / time_step.total_seconds()
     movable = LatticeActionableMovable(
         states=[State(StateVector(centre), timestamp=timestamp)],
         position_mapping=(0, 1),
         vigil_map=vigil_map,
         speed_cells=t.speed,
+        type_name=type_name,
         max_speed=max_speed * (1 + 1e-9),
     )
     sensor = VigilFOVSensor.for_type(vigil_map, type_name, **dict(sensor_kwargs or {}))
     return Platform(movement_controller=movable, sensors=[sensor], id=str(platform_id))
 
 
+def _movable_type(platform) -> str | None:
+    """The Vigil type a platform's movable moves as (a
+    :class:`LatticeActionableMovable`'s ``type_name``), or None."""
+    movable = getattr(platform, "movement_controller", None)
+    return movable.type_name if isinstance(movable, LatticeActionableMovable) else None
+
+
 def check_actions(
     config: Mapping[Any, Sequence[Any]],
     vigil_map: VigilMap,
-    speeds: Mapping[str, int] | int = 1,
+    speeds: Mapping[str, int] | int | None = 1,
+    types: Mapping[str, str] | str | None = None,
 ) -> None:
     """Checks a ``{platform: [action]}`` configuration: each platform's first
-    move action must be legal for its speed (a ``{platform id: speed}``
-    mapping or one speed for all). Raises :class:`IllegalMoveError`."""
+    move action must be legal for its sensor type and speed. ``types`` is a
+    ``{platform id: type}`` mapping or one type for all; by default each
+    platform's :class:`LatticeActionableMovable` ``type_name``, else
+    ``default``. ``speeds`` is a ``{platform id: speed}`` mapping, one speed
+    for all, or None for each type's speed. Raises
+    :class:`IllegalMoveError`."""
     for platform, actions in config.items():
         moves = [a for a in actions if isinstance(a, MovePositionAction)]
         if not moves:
             continue
         pid = getattr(platform, "id", None)
-        speed = speeds if isinstance(speeds, int) else speeds[pid]
+        if types is None:
+            type_name = _movable_type(platform) or "default"
+        else:
+            type_name = types if isinstance(types, str) else types.get(pid, "default")
+        if speeds is None:
+            speed = vigil_map.sensor_type(type_name).speed
+        else:
+            speed = speeds if isinstance(speeds, int) else speeds[pid]
         try:
-            vigil_map.check_move(_xy(platform.position), _xy(moves[0].target_value), speed)
+            vigil_map.check_move(
+                _xy(platform.position), _xy(moves[0].target_value), speed, type_name
+            )
         except IllegalMoveError as e:
             raise IllegalMoveError(f"platform {pid!r}: {e}") from None
 
@@ -519,7 +838,10 @@ class VigilSensorManager(SensorManager):
     position generator with ``action_from_value`` (a
     :class:`MaxSpeedActionableMovable`, e.g. :class:`LatticeActionableMovable`
     from :func:`make_platform`). ``sensor_types`` maps platform ids to Vigil
-    sensor types (``default`` otherwise).
+    sensor types (``default`` otherwise); a platform whose
+    :class:`LatticeActionableMovable` moves as another type is refused, and
+    each move is checked against the platform's type (a ground type never
+    stands on or crosses a building's cell).
 
     Each call of :meth:`choose_actions` is one Vigil step: the platforms
     stand where their last look was taken, and the returned moves end at
@@ -559,6 +881,16 @@ class VigilSensorManager(SensorManager):
         summary = self.client.get_scenario(self.scenario_id)
         spec = summary.spec.to_dict() if hasattr(summary.spec, "to_dict") else dict(summary.spec)
         self.map = VigilMap(spec, self.origin)
+        if self.map.obstacles and (self.plan_options or {}).get("estimator") == "paper":
+            raise ValueError(
+                f"scenario {self.scenario_id!r} has obstacles, which the paper estimator "
+                "does not model: choose another estimator in plan_options"
+            )
+        for pid, name in (self.sensor_types or {}).items():
+            try:
+                self.map.sensor_type(name)
+            except KeyError as e:
+                raise ValueError(f"sensor_types[{pid!r}]: {e.args[0]}") from None
         if not 0 <= self.history_steps <= 32:
             raise ValueError(f"history_steps must be in 0..=32, got {self.history_steps}")
         self._looks: deque[tuple[datetime.datetime, list[dict]]] = deque()
@@ -586,6 +918,15 @@ class VigilSensorManager(SensorManager):
                     "platform an explicit id (Platform(..., id='p1')) so that it maps to the "
                     "same Vigil sensor at every step"
                 )
+        for platform in platforms:
+            moves_as = _movable_type(platform)
+            if moves_as is not None and moves_as != self.type_of(platform):
+                raise ValueError(
+                    f"platform {platform.id!r} moves as Vigil type {moves_as!r} (its "
+                    f"LatticeActionableMovable) but the manager plans it as "
+                    f"{self.type_of(platform)!r}: give sensor_types={{{str(platform.id)!r}: "
+                    f"{moves_as!r}}}"
+                )
         return platforms
 
     def _now(self, platforms, timestamp: datetime.datetime) -> datetime.datetime:
@@ -603,10 +944,12 @@ class VigilSensorManager(SensorManager):
     def _sensor(self, platform) -> dict:
         xy = _xy(platform.position)
         cell = self.map.cell_of(xy)  # ValueError outside the zone
-        if not self.map.is_free(cell):
-            raise ValueError(f"platform {platform.id!r} stands on no-go ground, cell {cell}")
+        type_name = self.type_of(platform)
+        why = self.map.blocked_reason(cell, type_name)
+        if why is not None:
+            raise ValueError(f"platform {platform.id!r} stands on {why}, cell {cell}")
         x, y = self.map.to_vigil(xy)
-        return {"id": str(platform.id), "x": x, "y": y, "type": self.type_of(platform)}
+        return {"id": str(platform.id), "x": x, "y": y, "type": type_name}
 
     def targets(self, tracks, now: datetime.datetime, *, updated_now: bool = False) -> list[dict]:
         """Vigil targets from Stone Soup ``tracks`` at ``now``: each track's
@@ -714,11 +1057,12 @@ class VigilSensorManager(SensorManager):
             if plan is None or not plan.path:
                 raise IllegalMoveError(f"Vigil returned no path for platform {platform.id!r}")
             cell = (int(plan.path[0].col), int(plan.path[0].row))
-            speed = self.map.sensor_type(self.type_of(platform)).speed
+            type_name = self.type_of(platform)
+            speed = self.map.sensor_type(type_name).speed
             here = _xy(platform.position)
             target_xy = self.map.centre(cell)
             try:
-                self.map.check_move(here, target_xy, speed)
+                self.map.check_move(here, target_xy, speed, type_name)
             except IllegalMoveError as e:
                 raise IllegalMoveError(f"platform {platform.id!r}: {e}") from None
             config[platform] = [self._move(platform, target_xy, timestamp)]
@@ -768,6 +1112,7 @@ class _Flight:
     vel: np.ndarray  # per step
     leave: float  # distance from the source at which it leaves the zone
     flown: float  # distance flown from the source
+    stop: float = math.inf  # distance from the source at which a building ends its flight
 
 
 class VigilGroundTruthSimulator(GroundTruthSimulator):
@@ -781,12 +1126,15 @@ class VigilGroundTruthSimulator(GroundTruthSimulator):
     heading's direction when ``direction`` is absent, spread 180 by default)
     and a speed from the source's ``speeds`` (weights normalised;
     ``target_speed`` without them), then flies straight at that speed.
-    A target exists while inside the closed zone: its
-    :class:`GroundTruthPath` (id ``"t<n>"``, states ``[x, vx, y, vy]`` in
-    Stone Soup coordinates, velocities per second) has a state at every step
-    it is inside (each state's ``metadata["path_id"]`` is the path's id); it
-    is dropped once it leaves. Targets whose ray misses the zone never
-    appear.
+    A target's flight ends where its ray first enters a building's
+    interior (the spec's ``obstacles`` of kind ``building``; screens do not
+    stop targets): from there on it is gone, as if it had left the zone.
+    A target exists while inside the closed zone and before that point:
+    its :class:`GroundTruthPath` (id ``"t<n>"``, states ``[x, vx, y, vy]``
+    in Stone Soup coordinates, velocities per second) has a state at every
+    step it is inside (each state's ``metadata["path_id"]`` is the path's
+    id); it is dropped once it leaves or is stopped. Targets whose ray
+    misses the zone, or meets a building before it, never appear.
 
     With ``stationary_start`` (default) the first step already holds the
     stationary population (targets emitted over a window long enough for
@@ -846,10 +1194,15 @@ class VigilGroundTruthSimulator(GroundTruthSimulator):
             span = _ray_in_zone(src["pos"], u, self.map.width, self.map.height)
             if span is None:
                 continue  # its ray misses the zone: it never appears
-            self._count += 1
+            stop = self.map.flight_stop(src["pos"], u)
+            if stop <= span[0]:
+                continue  # a building ends its flight before the zone
             flown = speed * age
+            if flown >= stop:
+                continue  # stopped already (emitted before the first step)
+            self._count += 1
             out.append(_Flight(GroundTruthPath(id=f"t{self._count}"),
-                               src["pos"] + u * flown, u * speed, span[1], flown))
+                               src["pos"] + u * flown, u * speed, span[1], flown, stop))
         return out
 
     @BufferedGenerator.generator_method
@@ -869,7 +1222,7 @@ class VigilGroundTruthSimulator(GroundTruthSimulator):
                 for f in flights:
                     f.pos = f.pos + f.vel
                     f.flown += float(np.hypot(*f.vel))
-                flights = [f for f in flights if f.flown <= f.leave + 1e-9]
+                flights = [f for f in flights if f.flown <= f.leave + 1e-9 and f.flown < f.stop]
                 for src in self._sources:
                     flights += self._emit(src, 1.0, rng)
             current = set()

@@ -24,6 +24,8 @@ from .joint_stop import JointStop
 from .no_go_spec import NoGoSpec
 from .objective import Objective
 from .observed import Observed
+from .obstacle_kind_name import ObstacleKindName
+from .obstacle_spec import ObstacleSpec
 from .plan_out import PlanOut
 from .plan_request import PlanRequest
 from .plan_request_by_id import PlanRequestById
@@ -79,6 +81,8 @@ __all__ = (
     "NoGoSpec",
     "Objective",
     "Observed",
+    "ObstacleKindName",
+    "ObstacleSpec",
     "PlanOut",
     "PlanRequest",
     "PlanRequestById",

@@ -13,6 +13,7 @@ if TYPE_CHECKING:
     from ..models.fov_spec_type_0 import FovSpecType0
     from ..models.fov_spec_type_1 import FovSpecType1
     from ..models.no_go_spec import NoGoSpec
+    from ..models.obstacle_spec import ObstacleSpec
     from ..models.scenario_spec_sensor_types_type_0 import ScenarioSpecSensorTypesType0
     from ..models.source_spec import SourceSpec
     from ..models.zone_spec import ZoneSpec
@@ -38,6 +39,11 @@ class ScenarioSpec:
         name (None | str | Unset): Free-form label.
         no_go (list[NoGoSpec] | None | Unset): Ground no sensor may stand on: a cell whose centre lies in one of
             these rectangles (edges included) is blocked. Targets fly over it.
+        obstacles (list[ObstacleSpec] | None | Unset): Buildings and screens (at most 64 convex polygons): sight lines
+            that meet an obstacle's interior are blocked (elevated sensor types
+            see over them), a target's flight ends where it enters a building,
+            and no ground sensor stands on or crosses a cell whose centre lies
+            in a building (see `docs/obstacles.md`).
         p_detect (float | None | Unset): Detection probability of the type `default`, in (0, 1] (default 1).
         rays_per_pi (int | None | Unset): Rays per π radians in each source's angular grid, over which the
             exact estimator integrates (32..=1024; default 128 when every field
@@ -61,6 +67,7 @@ class ScenarioSpec:
     min_separation: int | None | Unset = UNSET
     name: None | str | Unset = UNSET
     no_go: list[NoGoSpec] | None | Unset = UNSET
+    obstacles: list[ObstacleSpec] | None | Unset = UNSET
     p_detect: float | None | Unset = UNSET
     rays_per_pi: int | None | Unset = UNSET
     sensor_speed: int | None | Unset = UNSET
@@ -118,6 +125,18 @@ class ScenarioSpec:
         else:
             no_go = self.no_go
 
+        obstacles: list[dict[str, Any]] | None | Unset
+        if isinstance(self.obstacles, Unset):
+            obstacles = UNSET
+        elif isinstance(self.obstacles, list):
+            obstacles = []
+            for obstacles_type_0_item_data in self.obstacles:
+                obstacles_type_0_item = obstacles_type_0_item_data.to_dict()
+                obstacles.append(obstacles_type_0_item)
+
+        else:
+            obstacles = self.obstacles
+
         p_detect: float | None | Unset
         if isinstance(self.p_detect, Unset):
             p_detect = UNSET
@@ -168,6 +187,8 @@ class ScenarioSpec:
             field_dict["name"] = name
         if no_go is not UNSET:
             field_dict["no_go"] = no_go
+        if obstacles is not UNSET:
+            field_dict["obstacles"] = obstacles
         if p_detect is not UNSET:
             field_dict["p_detect"] = p_detect
         if rays_per_pi is not UNSET:
@@ -186,6 +207,7 @@ class ScenarioSpec:
         from ..models.fov_spec_type_0 import FovSpecType0  # noqa: PLC0415
         from ..models.fov_spec_type_1 import FovSpecType1  # noqa: PLC0415
         from ..models.no_go_spec import NoGoSpec  # noqa: PLC0415
+        from ..models.obstacle_spec import ObstacleSpec  # noqa: PLC0415
         from ..models.scenario_spec_sensor_types_type_0 import (
             ScenarioSpecSensorTypesType0,
         )  # noqa: PLC0415
@@ -270,6 +292,30 @@ class ScenarioSpec:
 
         no_go = _parse_no_go(d.pop("no_go", UNSET))
 
+        def _parse_obstacles(data: object) -> list[ObstacleSpec] | None | Unset:
+            if data is None:
+                return data
+            if isinstance(data, Unset):
+                return data
+            try:
+                if not isinstance(data, list):
+                    raise TypeError()
+                obstacles_type_0 = []
+                _obstacles_type_0 = data
+                for obstacles_type_0_item_data in _obstacles_type_0:
+                    obstacles_type_0_item = ObstacleSpec.from_dict(
+                        obstacles_type_0_item_data
+                    )
+
+                    obstacles_type_0.append(obstacles_type_0_item)
+
+                return obstacles_type_0
+            except (TypeError, ValueError, AttributeError, KeyError):
+                pass
+            return cast(list[ObstacleSpec] | None | Unset, data)
+
+        obstacles = _parse_obstacles(d.pop("obstacles", UNSET))
+
         def _parse_p_detect(data: object) -> float | None | Unset:
             if data is None:
                 return data
@@ -334,6 +380,7 @@ class ScenarioSpec:
             min_separation=min_separation,
             name=name,
             no_go=no_go,
+            obstacles=obstacles,
             p_detect=p_detect,
             rays_per_pi=rays_per_pi,
             sensor_speed=sensor_speed,

@@ -23,12 +23,16 @@ class SensorTypeSpec:
 
     Attributes:
         fov (FovSpecType0 | FovSpecType1): Field of view of every sensor, tagged by `shape`.
+        elevated (bool | None | Unset): True for a type that sees over every obstacle and may fly over
+            buildings (a drone); false by default (a ground sensor, whose sight
+            lines obstacles block and which never stands on a building's cell).
         p_detect (float | None | Unset): Probability of detecting a target inside the field of view at a
             step, in (0, 1]; 1 by default.
         speed (int | None | Unset): Cells (king moves) per step, 1..=3; 1 by default.
     """
 
     fov: FovSpecType0 | FovSpecType1
+    elevated: bool | None | Unset = UNSET
     p_detect: float | None | Unset = UNSET
     speed: int | None | Unset = UNSET
 
@@ -40,6 +44,12 @@ class SensorTypeSpec:
             fov = self.fov.to_dict()
         else:
             fov = self.fov.to_dict()
+
+        elevated: bool | None | Unset
+        if isinstance(self.elevated, Unset):
+            elevated = UNSET
+        else:
+            elevated = self.elevated
 
         p_detect: float | None | Unset
         if isinstance(self.p_detect, Unset):
@@ -60,6 +70,8 @@ class SensorTypeSpec:
                 "fov": fov,
             }
         )
+        if elevated is not UNSET:
+            field_dict["elevated"] = elevated
         if p_detect is not UNSET:
             field_dict["p_detect"] = p_detect
         if speed is not UNSET:
@@ -91,6 +103,15 @@ class SensorTypeSpec:
 
         fov = _parse_fov(d.pop("fov"))
 
+        def _parse_elevated(data: object) -> bool | None | Unset:
+            if data is None:
+                return data
+            if isinstance(data, Unset):
+                return data
+            return cast(bool | None | Unset, data)
+
+        elevated = _parse_elevated(d.pop("elevated", UNSET))
+
         def _parse_p_detect(data: object) -> float | None | Unset:
             if data is None:
                 return data
@@ -111,6 +132,7 @@ class SensorTypeSpec:
 
         sensor_type_spec = cls(
             fov=fov,
+            elevated=elevated,
             p_detect=p_detect,
             speed=speed,
         )
