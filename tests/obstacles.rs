@@ -297,11 +297,12 @@ fn stationary_counts_match_a_simulation() {
     assert!(blind.expected_targets_in_zone > 1.05 * ground.expected_targets_in_zone);
 }
 
-/// The exact estimator's value of a ground camera with only the looks of
-/// now behind it, against a brute-force integral over a fine grid of
-/// points of its field of view: the density of each class where the
-/// camera sees the point and no building has ended the flight, times the
-/// chance that every look of now missed the point's target there.
+/// The exact estimator's value of a look with only the looks of now
+/// behind it (and at some probes an excluded look), against a brute-force
+/// integral over a fine grid of points of its field of view: the density
+/// of each class where the look sees the point and no building has ended
+/// the flight, times the chance that every look of now missed the point's
+/// target there and that the excluded look misses it now.
 #[test]
 fn values_match_a_brute_force_integral() {
     use vigil::estimator::{Estimator, ExactEstimator, Precomputed, Situation, SourceRays};
@@ -333,12 +334,18 @@ fn values_match_a_brute_force_integral() {
             horizon: 2,
         },
     );
-    for (sensor, k, t) in [
-        (0, cell(6, 11), 1),
-        (1, cell(4, 6), 2),
-        (0, cell(6, 10), 1),
-        (2, cell(10, 12), 1),
+    // With an excluded look in half the probes: a camera east of the
+    // building, whose view the building cuts, or the drone above it.
+    let excluded = [s.look(types[0], cell(7, 8)), s.look(types[2], cell(9, 10))];
+    for (sensor, k, t, x) in [
+        (0, cell(6, 11), 1, None),
+        (1, cell(4, 6), 2, None),
+        (0, cell(6, 10), 1, Some(0)),
+        (2, cell(10, 12), 1, None),
+        (1, cell(5, 7), 1, Some(0)),
+        (0, cell(7, 10), 2, Some(1)),
     ] {
+        let excluded: Vec<Look> = x.map(|i| excluded[i]).into_iter().collect();
         let look = s.look(types[sensor], k);
         let r = look.region.rect;
         let n = 600;
@@ -371,12 +378,21 @@ fn values_match_a_brute_force_integral() {
                                 .map(Look::miss)
                                 .product()
                         };
-                        brute += class.rate / (src.spread * class.speed * dist) * miss * hx * hy;
+                        let miss_now: f64 = excluded
+                            .iter()
+                            .filter(|l| s.detects(l, q))
+                            .map(Look::miss)
+                            .product();
+                        brute += class.rate / (src.spread * class.speed * dist)
+                            * miss
+                            * miss_now
+                            * hx
+                            * hy;
                     }
                 }
             }
         }
-        let value = est.value(sensor, k, t, &[]) / look.p_detect;
+        let value = est.value(sensor, k, t, &excluded) / look.p_detect;
         eprintln!("sensor {sensor} at {k:?}, t {t}: estimator {value:.5}, brute force {brute:.5}");
         assert!(
             (value - brute).abs() < 0.01 * brute + 1e-3,

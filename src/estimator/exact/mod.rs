@@ -197,7 +197,15 @@ impl<'a> ExactEstimator<'a> {
         let seen = classes
             .par_iter()
             .with_min_len(crate::parallel::min_len())
-            .map(|c| RayHits::new(&rays[c.rays], observed, &keys, &sights, c.speed))
+            .map(|c| {
+                let hits = RayHits::new(&rays[c.rays], observed, &keys, &sights, c.speed);
+                // The sighted path measures parts of rays by prefix sums.
+                if scenario.has_obstacles() {
+                    hits.with_prefix()
+                } else {
+                    hits
+                }
+            })
             .collect();
 
         let grid = grid.filter(|_| scenario.all_square());
@@ -453,6 +461,10 @@ impl Estimator for ExactEstimator<'_> {
 
     fn fill(&self, sensor: usize, start: Cell, t: usize, excluded: &[Look], out: &mut ValueGrid) {
         let s = self.scenario;
+        if s.has_obstacles() {
+            self.fill_sighted(sensor, start, t, excluded, out);
+            return;
+        }
         let Some((grid, win)) = self
             .window_of(sensor, t)
             .filter(|_| self.starts.get(sensor) == Some(&start))

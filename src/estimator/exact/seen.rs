@@ -35,6 +35,9 @@ pub(super) struct RayHits {
     /// Aligned with `hits`: the detection probability of each interval.
     /// Empty when every look is certain (every interval's is 1).
     detected: Vec<f64>,
+    /// Aligned with `hits`, once [`RayHits::with_prefix`] built it: the
+    /// detected length of the ray's earlier intervals.
+    before: Vec<f64>,
 }
 
 impl RayHits {
@@ -166,6 +169,7 @@ impl RayHits {
             offsets,
             hits,
             detected,
+            before: Vec::new(),
         }
     }
 
@@ -283,6 +287,7 @@ impl RayHits {
             offsets,
             hits,
             detected: Vec::new(),
+            before: Vec::new(),
         }
     }
 
@@ -307,6 +312,46 @@ impl RayHits {
     #[inline]
     pub(super) fn certain(&self) -> bool {
         self.detected.is_empty()
+    }
+
+    /// The same seen sets with the prefix sums that
+    /// [`RayHits::detected_upto`] reads.
+    pub(super) fn with_prefix(mut self) -> Self {
+        let mut before = Vec::with_capacity(self.hits.len());
+        for m in 0..self.offsets.len().saturating_sub(1) {
+            let mut acc = 0.0;
+            for i in self.offsets[m] as usize..self.offsets[m + 1] as usize {
+                before.push(acc);
+                let (a, b) = self.hits[i];
+                acc += (b - a) * self.detected.get(i).copied().unwrap_or(1.0);
+            }
+        }
+        self.before = before;
+        self
+    }
+
+    /// `∫_{−∞}^{x} detected` along ray `m` as of step 0 (needs
+    /// [`RayHits::with_prefix`]): a binary search, so that a part of a ray
+    /// is measured without walking or sorting its pieces (a seen set of a
+    /// long history has dozens on a ray).
+    #[inline]
+    pub(super) fn detected_upto(&self, m: usize, x: f64) -> f64 {
+        let (lo, hi) = (self.offsets[m] as usize, self.offsets[m + 1] as usize);
+        if lo == hi {
+            return 0.0;
+        }
+        let pieces = &self.hits[lo..hi];
+        // The first piece that ends after x.
+        let j = pieces.partition_point(|p| p.1 <= x);
+        let d = |i: usize| self.detected.get(i).copied().unwrap_or(1.0);
+        match pieces.get(j) {
+            Some(&(x0, _)) if x > x0 => self.before[lo + j] + (x - x0) * d(lo + j),
+            Some(_) => self.before[lo + j],
+            None => {
+                let (x0, x1) = pieces[hi - lo - 1];
+                self.before[hi - 1] + (x1 - x0) * d(hi - 1)
+            }
+        }
     }
 }
 

@@ -5,19 +5,40 @@
 //! A look at cell `k` counts, on each ray of each class crossing `F_k`, the
 //! part of the ray inside `F_k`, before the ray's stop (where a building
 //! ends the flights along it) and visible from `k` ([`Sight::visible`]);
-//! on that part a target is still unseen with probability `Π (1 − p)` over
-//! the seen pieces (which hold only what each past look saw) and the
-//! excluded looks' visible pieces. So `U(k,t) = Σ_c w_c Σ_rays ∫ (1 − D)`
-//! over those parts, `D` the detection profile of [`detection_within`]:
-//! the same interval arithmetic and midpoint rule as without obstacles,
-//! evaluated per cell (the elementary grid's block sums assume fields of
-//! view that are unions of rectangles, which blocked sight lines break).
+//! on that part a target is still unseen with probability
+//! `(1 − d(r))·(1 − q(r))`: `d` the detection profile of the seen set
+//! (which holds only what each past look saw), `q` that of the excluded
+//! looks' visible pieces. So
+//! `U(k,t) = Σ_c w_c Σ_rays [∫ (1 − d) − ∫ q (1 − d)]` over those parts:
+//! the first integral by the seen set's prefix sums
+//! ([`RayHits::detected_upto`](super::seen::RayHits::detected_upto), a
+//! binary search), the second over the few pieces where excluded looks
+//! hold the ray. The same interval arithmetic and midpoint rule as without
+//! obstacles, evaluated per cell (the elementary grid's block sums assume
+//! fields of view that are unions of rectangles, which blocked sight lines
+//! break).
 
 use super::ExactEstimator;
 use crate::estimator::Target;
-use crate::geometry::{Point, detection_within};
+use crate::geometry::{Point, detection_pieces};
+use crate::limits::MAX_SPEED_CLASSES;
 use crate::obstacle::Sight;
 use crate::scenario::{Cell, Look};
+use crate::search::ValueGrid;
+
+/// A look that excludes part of the targets, with what it cannot see.
+type Excluded<'a> = (&'a Look, Option<Sight>);
+
+/// Scratch space of one value, kept across the cells of a fill.
+#[derive(Default)]
+struct Scratch {
+    buf: Vec<Point>,
+    parts: Vec<(f64, f64)>,
+    cut: Vec<(f64, f64)>,
+    pieces: Vec<(f64, f64, f64)>,
+    segments: Vec<(f64, f64, f64)>,
+    events: Vec<(f64, f64, bool)>,
+}
 
 impl ExactEstimator<'_> {
     /// True when the reported target `tg` still flies at step `t`: its
@@ -32,28 +53,97 @@ impl ExactEstimator<'_> {
         obstacles.stop(tg.pos, d) > speed * t as f64
     }
 
+    /// The looks of `excluded` that may meet `region`'s, each with what it
+    /// cannot see.
+    fn excluded_sights<'x>(
+        &self,
+        excluded: &'x [Look],
+        region: &crate::geometry::Region,
+    ) -> Vec<Excluded<'x>> {
+        excluded
+            .iter()
+            .filter(|x| x.region.may_overlap(region))
+            .map(|x| (x, self.scenario.sight(x)))
+            .collect()
+    }
+
     /// The value of `sensor` at `k` at step `t` against `excluded`, with
     /// obstacles: `p_detect ×` (the reported targets it sees, each weighed
     /// by the chance that every excluded look that sees it misses it, plus
     /// the unseen targets in the part of `F_k` it sees).
     pub(super) fn value_sighted(&self, sensor: usize, k: Cell, t: usize, excluded: &[Look]) -> f64 {
+        let fk = self.scenario.fov_region_of(self.types[sensor], k);
+        let near = self.excluded_sights(excluded, &fk);
+        let refs: Vec<&Excluded<'_>> = near.iter().collect();
+        self.sighted_at(sensor, k, t, &refs, &mut Scratch::default())
+    }
+
+    /// [`Estimator::fill`](crate::estimator::Estimator::fill) with
+    /// obstacles: the excluded looks' sights once for the whole reach.
+    pub(super) fn fill_sighted(
+        &self,
+        sensor: usize,
+        start: Cell,
+        t: usize,
+        excluded: &[Look],
+        out: &mut ValueGrid,
+    ) {
+        let s = self.scenario;
+        let ty = self.types[sensor];
+        // Every look that may meet a field of view of the reach.
+        let reach = {
+            let r = s.fov_region_of(ty, start);
+            let m = s.cell_size * (s.types[ty].speed * t + 1) as f64;
+            crate::geometry::Region {
+                rect: crate::geometry::Rect {
+                    x0: r.rect.x0 - m,
+                    y0: r.rect.y0 - m,
+                    x1: r.rect.x1 + m,
+                    y1: r.rect.y1 + m,
+                },
+                disk: None,
+            }
+        };
+        let near = self.excluded_sights(excluded, &reach);
+        let mut scratch = Scratch::default();
+        let mut refs = Vec::with_capacity(near.len());
+        out.fill_step(t, |dc, dr| {
+            let k = Cell {
+                col: start.col + dc,
+                row: start.row + dr,
+            };
+            if !s.on_lattice(k) {
+                return None;
+            }
+            let fk = s.fov_region_of(ty, k);
+            refs.clear();
+            refs.extend(near.iter().filter(|(x, _)| x.region.may_overlap(&fk)));
+            Some(self.sighted_at(sensor, k, t, &refs, &mut scratch))
+        });
+    }
+
+    /// The value of `sensor` at `k` at step `t` against the excluded looks
+    /// `near` (those that may meet its field of view).
+    fn sighted_at(
+        &self,
+        sensor: usize,
+        k: Cell,
+        t: usize,
+        near: &[&Excluded<'_>],
+        scratch: &mut Scratch,
+    ) -> f64 {
         let s = self.scenario;
         let ty = &s.types[self.types[sensor]];
         let look = s.look(self.types[sensor], k);
         let fk = look.region;
         let sight = s.sight(&look);
-        let near: Vec<(&Look, Option<Sight>)> = excluded
-            .iter()
-            .filter(|x| x.region.may_overlap(&fk))
-            .map(|x| (x, s.sight(x)))
-            .collect();
         let sees = |sight: &Option<Sight>, p: Point| sight.as_ref().is_none_or(|v| v.sees(p));
         let known: f64 = self
             .known
             .iter()
-            .filter(|tg| self.known_alive(tg, t))
+            .filter(|tg| fk.contains(tg.at(t)) && self.known_alive(tg, t))
             .map(|tg| tg.at(t))
-            .filter(|&p| fk.contains(p) && sees(&sight, p))
+            .filter(|&p| sees(&sight, p))
             .map(|p| {
                 near.iter()
                     .filter(|(x, v)| x.region.contains(p) && sees(v, p))
@@ -61,7 +151,7 @@ impl ExactEstimator<'_> {
                     .product::<f64>()
             })
             .sum();
-        ty.p_detect * (known + self.unseen_sighted(&look, sight.as_ref(), t, &near))
+        ty.p_detect * (known + self.unseen_sighted(&look, sight.as_ref(), t, near, scratch))
     }
 
     /// `U` of `look` at step `t` (see the module docs).
@@ -70,23 +160,37 @@ impl ExactEstimator<'_> {
         look: &Look,
         sight: Option<&Sight>,
         t: usize,
-        excluded: &[(&Look, Option<Sight>)],
+        excluded: &[&Excluded<'_>],
+        scratch: &mut Scratch,
     ) -> f64 {
         let fk = &look.region;
-        let mut buf = Vec::new();
-        let mut parts: Vec<(f64, f64)> = Vec::new();
-        let mut cut: Vec<(f64, f64)> = Vec::new();
-        let mut pieces: Vec<(f64, f64, f64)> = Vec::new();
-        let mut events = Vec::new();
+        let Scratch {
+            buf,
+            parts,
+            cut,
+            pieces,
+            segments,
+            events,
+        } = scratch;
         let mut unseen = 0.0;
-        for (class, hits) in self.classes.iter().zip(&self.seen) {
-            let sr = &self.rays[class.rays];
+        // The classes of a source are consecutive and share its rays.
+        let mut first = 0;
+        while first < self.classes.len() {
+            let ri = self.classes[first].rays;
+            let last = first
+                + self.classes[first..]
+                    .iter()
+                    .take_while(|c| c.rays == ri)
+                    .count();
+            let classes = first..last;
+            first = last;
+            let sr = &self.rays[ri];
             let o = sr.source.pos;
-            let lift = class.speed * t as f64;
-            let Some((a, b)) = sr.range(fk, &mut buf) else {
+            let Some((a, b)) = sr.range(fk, buf) else {
                 continue;
             };
-            let mut sum = 0.0;
+            // A source has at most MAX_SPEED_CLASSES classes.
+            let mut sums = [0.0; MAX_SPEED_CLASSES];
             for m in a..b {
                 let (d, inv) = sr.dirs[m];
                 let Some((lo, hi)) = fk.ray(o, d, inv) else {
@@ -98,22 +202,15 @@ impl ExactEstimator<'_> {
                 }
                 parts.clear();
                 match sight {
-                    Some(v) => v.visible(o, d, lo, hi, &mut parts),
+                    Some(v) => v.visible(o, d, lo, hi, parts),
                     None => parts.push((lo, hi)),
                 }
                 if parts.is_empty() {
                     continue;
                 }
-                // What was seen (pushed to step t) and what the excluded
-                // looks see on this ray.
+                // Where the excluded looks hold this ray, cut into pieces
+                // of one detection probability each.
                 pieces.clear();
-                let (iv, detected) = (hits.of(m), hits.detected(m));
-                for (i, &(p, q)) in iv.iter().enumerate() {
-                    if q + lift > lo && p + lift < hi {
-                        let pd = detected.get(i).copied().unwrap_or(1.0);
-                        pieces.push((p + lift, q + lift, pd));
-                    }
-                }
                 for (x, v) in excluded {
                     let Some((p, q)) = x.region.ray(o, d, inv) else {
                         continue;
@@ -125,20 +222,38 @@ impl ExactEstimator<'_> {
                     match v {
                         Some(v) => {
                             cut.clear();
-                            v.visible(o, d, p, q, &mut cut);
+                            v.visible(o, d, p, q, cut);
                             pieces.extend(cut.iter().map(|&(p, q)| (p, q, x.p_detect)));
                         }
                         None => pieces.push((p, q, x.p_detect)),
                     }
                 }
-                for &(p, q) in &parts {
-                    sum += q - p;
-                    if !pieces.is_empty() {
-                        sum -= detection_within(&pieces, p, q, &mut events);
+                segments.clear();
+                if !pieces.is_empty() {
+                    detection_pieces(pieces, lo, hi, events, |u, v, q| segments.push((u, v, q)));
+                }
+                for (slot, c) in classes.clone().enumerate() {
+                    let (class, hits) = (&self.classes[c], &self.seen[c]);
+                    let lift = class.speed * t as f64;
+                    let seen = |u: f64, v: f64| {
+                        hits.detected_upto(m, v - lift) - hits.detected_upto(m, u - lift)
+                    };
+                    let mut sum = 0.0;
+                    for &(p, q) in parts.iter() {
+                        sum += (q - p) - seen(p, q);
+                        for &(u, v, qx) in segments.iter() {
+                            let (u, v) = (u.max(p), v.min(q));
+                            if v > u {
+                                sum -= qx * ((v - u) - seen(u, v));
+                            }
+                        }
                     }
+                    sums[slot] += sum;
                 }
             }
-            unseen += class.weight * sum;
+            for (slot, c) in classes.enumerate() {
+                unseen += self.classes[c].weight * sums[slot];
+            }
         }
         unseen
     }
