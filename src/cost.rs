@@ -28,6 +28,11 @@
 //! | grid: rects × cone sources | 2.328e-4 | the same, wedge integrals |
 //! | crossings: rays × (nx + ny) | 6.406e-6 | the index of the rays' crossings of the grid |
 //!
+//! With obstacles the statistics cast rays instead of the closed forms,
+//! and [`precompute_ms`] adds them ([`obstacle_rays`], with two
+//! coefficients of their own). A plan with obstacles takes the general
+//! path, whose terms below count it.
+//!
 //! Plan ([`plan_ms`]); `n` sensors, horizon `T`; per sensor and step `t`
 //! its reachable cells `(2vt+1)²` clipped to the lattice and their block of
 //! elementary rectangles; `E`: the sensors whose looks can meet that reach
@@ -65,6 +70,7 @@ use crate::estimator::{
     SourceRays,
 };
 use crate::geometry::Point;
+use crate::limits::OBSTACLE_STATS_RAYS_PER_PI;
 use crate::planner::{EstimatorKind, Observed, PlanInput, Planner};
 use crate::scenario::{Cell, FovSpec, Scenario, Source};
 use crate::stats::{ESCAPE_SAMPLES, angular_span};
@@ -209,7 +215,46 @@ impl PlanTerms {
 /// core: positive and finite for every valid scenario; O(sources + fields
 /// of view) to compute.
 pub fn precompute_ms(s: &Scenario) -> f64 {
-    dot(&PRECOMPUTE_MODEL, &precompute_terms(s).to_array()).max(FLOOR_MS)
+    let work = dot(&PRECOMPUTE_MODEL, &precompute_terms(s).to_array()).max(FLOOR_MS);
+    let obstacles = s.obstacles.list().len() as f64;
+    work + obstacle_rays(s) * (OBSTACLE_MS_PER_RAY + OBSTACLE_MS_PER_RAY_AND_OBSTACLE * obstacles)
+}
+
+/// Milliseconds per ray of the statistics of a scenario with obstacles
+/// ([`obstacle_rays`]), and per ray and obstacle: a two-term model fitted
+/// on `site-campus` with its twelve obstacles and with four (its figures
+/// are in `docs/obstacles.md`). Those statistics integrate every cell's
+/// visible field of view along rays ([`crate::stats`]), where the closed
+/// forms the model's other terms count no longer apply.
+const OBSTACLE_MS_PER_RAY: f64 = 1.6e-5;
+/// See [`OBSTACLE_MS_PER_RAY`].
+const OBSTACLE_MS_PER_RAY_AND_OBSTACLE: f64 = 1.6e-6;
+
+/// The rays the statistics of a scenario with obstacles cast: per view,
+/// cell and source, the angle the field of view spans seen from the
+/// source at the zone centre's distance, at [`OBSTACLE_STATS_RAYS_PER_PI`]
+/// rays per π. Zero without obstacles.
+fn obstacle_rays(s: &Scenario) -> f64 {
+    if !s.has_obstacles() {
+        return 0.0;
+    }
+    let centre = Point::new(s.width / 2.0, s.height / 2.0);
+    let inverse_distances: f64 = s
+        .sources
+        .iter()
+        .filter(|src| src.rate > 0.0)
+        .map(|src| {
+            1.0 / (src.pos.x - centre.x)
+                .hypot(src.pos.y - centre.y)
+                .max(s.cell_size)
+        })
+        .sum();
+    let spans: f64 = s
+        .fovs
+        .iter()
+        .map(|&fov| 2.0 * half(fov) * inverse_distances / std::f64::consts::PI)
+        .sum();
+    s.cell_count() as f64 * spans * OBSTACLE_STATS_RAYS_PER_PI as f64
 }
 
 /// Predicted CPU time of planning `input` on `planner`
@@ -721,6 +766,30 @@ mod tests {
             [0, 4, 16, 32].map(|h| cost(10, 3, 50, h, Priority)),
         );
         increasing("coordination", MODES.map(|c| cost(10, 3, 50, 16, c)));
+    }
+
+    /// Obstacles add the statistics' rays: more with more obstacles and
+    /// more cells, none without.
+    #[test]
+    fn precompute_cost_grows_with_obstacles() {
+        let campus = crate::scenario::site_campus_spec();
+        let cost = |spec: crate::scenario::ScenarioSpec| {
+            precompute_ms(&Scenario::new(spec).expect("valid"))
+        };
+        let without = cost(crate::scenario::ScenarioSpec {
+            obstacles: None,
+            ..campus.clone()
+        });
+        let mut four = campus.clone();
+        four.obstacles.as_mut().expect("obstacles").truncate(4);
+        let finer = crate::scenario::ScenarioSpec {
+            cell_size: 5.0,
+            ..campus.clone()
+        };
+        increasing(
+            "obstacles, then cells",
+            [without, cost(four), cost(campus), cost(finer)],
+        );
     }
 
     #[test]
