@@ -523,7 +523,10 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> PlanTerms {
     // An exact plan's certificate takes one more search per sensor, with
     // no exclusion; `joint` is `iterated`'s work (its budget is added in
     // `plan_ms`).
-    let passes: &[(f64, f64)] = match (input.coordination, exact) {
+    // Without the certificate an exact plan skips its search (`joint`
+    // always certifies).
+    let certified = exact && (input.certify || input.coordination == Coordination::Joint);
+    let passes: &[(f64, f64)] = match (input.coordination, certified) {
         (Coordination::None, false) => &[(1.0, 0.0)],
         (Coordination::None, true) => &[(1.0, 0.0), (1.0, 0.0)],
         (Coordination::Priority, false) => &[(1.0, 0.0), (1.0, 0.5)],

@@ -52,10 +52,10 @@ use utoipa::ToSchema;
 use crate::coordination::{Coordination, Objective};
 use crate::geometry::Point;
 use crate::limits::{DEFAULT_HISTORY_STEPS, MAX_HISTORY_STEPS, MAX_TARGETS};
-use crate::planner::check_objective;
 use crate::planner::{
     EstimatorKind, Id, Observed, PlanRequest, Planner, PositionIn, SensorIn, TargetIn,
 };
+use crate::planner::{check_certify, check_objective};
 use crate::scenario::{Integer, ValidationError};
 
 /// A session's defaults for its steps; a step may override each but
@@ -90,20 +90,31 @@ pub struct SessionSettings {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(value_type = Option<u32>, minimum = 0)]
     pub history_steps: Option<Integer>,
+    /// Certify each step's plan (true by default; see the plan request's
+    /// `certify`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub certify: Option<bool>,
 }
 
 impl SessionSettings {
-    /// Checks what can be checked before any step: `history_steps`, and an
-    /// `objective` the `estimator` cannot serve (the rest is checked with
-    /// every step's plan request). Gives the history length.
+    /// Checks what can be checked before any step: `history_steps`, an
+    /// `objective` the `estimator` cannot serve, and `certify: false` with
+    /// `joint` (the rest is checked with every step's plan request). Gives
+    /// the history length.
     ///
     /// # Errors
-    /// A [`ValidationError`] naming `history_steps` or `objective`.
+    /// A [`ValidationError`] naming `history_steps`, `objective` or
+    /// `certify`.
     pub fn history_len(&self) -> Result<usize, ValidationError> {
         check_objective(
             "objective",
             self.objective,
             self.estimator.unwrap_or_default(),
+        )?;
+        check_certify(
+            "certify",
+            self.certify,
+            self.coordination.unwrap_or_default(),
         )?;
         match &self.history_steps {
             None => Ok(DEFAULT_HISTORY_STEPS),
@@ -154,6 +165,9 @@ pub struct StepRequest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(value_type = Option<u32>, minimum = 1)]
     pub budget_ms: Option<Integer>,
+    /// Certify this step's plan; the session's setting by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub certify: Option<bool>,
 }
 
 impl StepRequest {
@@ -377,6 +391,7 @@ impl Session {
                 .or_else(|| self.settings.min_separation.clone()),
             gap_target: step.gap_target,
             budget_ms: step.budget_ms.clone(),
+            certify: step.certify.or(self.settings.certify),
         };
         PreparedStep { request, tracks }
     }

@@ -145,6 +145,10 @@ struct WorkloadArgs {
     /// `iterated`, `joint`); the requests' own by default.
     #[arg(long, value_parser = parse_coordination)]
     coordination: Option<Coordination>,
+    /// `certify` every request sends (`true` or `false`: with `false` an
+    /// exact plan skips its certificate); the requests' own by default.
+    #[arg(long)]
+    certify: Option<bool>,
 }
 
 fn parse_objective(s: &str) -> Result<Objective, String> {
@@ -156,11 +160,12 @@ fn parse_coordination(s: &str) -> Result<Coordination, String> {
 }
 
 impl WorkloadArgs {
-    /// `reqs` with the objective and coordination asked for.
+    /// `reqs` with the objective, coordination and certificate asked for.
     fn override_settings(&self, mut reqs: Vec<PlanRequest>) -> Vec<PlanRequest> {
         for req in &mut reqs {
             req.objective = self.objective.or(req.objective);
             req.coordination = self.coordination.or(req.coordination);
+            req.certify = self.certify.or(req.certify);
         }
         reqs
     }

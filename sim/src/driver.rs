@@ -482,6 +482,7 @@ impl Sim {
             min_separation: self.min_separation.map(Into::into),
             gap_target: None,
             budget_ms: None,
+            certify: None,
         }
     }
 
@@ -542,6 +543,7 @@ impl Sim {
                 .filter(|&o| o != Objective::Detections),
             min_separation: self.min_separation.map(Into::into),
             history_steps: Some(history.into()),
+            certify: None,
         }
     }
 

@@ -140,7 +140,7 @@ pub struct Coordinated {
 /// speed through the scenario's free cells, and keeps the fleet's minimum
 /// separation from the others wherever it can (see the module docs). With
 /// an order-independent (exact) estimator the plan carries its
-/// [certificate].
+/// [certificate] when `certify` asks for it (`joint` always does).
 ///
 /// # Errors
 /// [`Cancelled`] once the fleet's token is cancelled: it is checked before
@@ -150,8 +150,10 @@ pub fn coordinate(
     fleet: &Fleet,
     mode: Coordination,
     joint: JointSettings,
+    certify: bool,
     started: Instant,
 ) -> Result<Coordinated, Cancelled> {
+    let certify = certify || mode == Coordination::Joint;
     let Fleet {
         est,
         starts,
@@ -185,7 +187,7 @@ pub fn coordinate(
     order.sort_by(|&a, &b| plans[b].value.total_cmp(&plans[a].value));
     // Each sensor's lone values, which the later passes start from; an
     // exact plan's certificate starts from them too.
-    let grids_wanted = mode != Coordination::None || d > 0 || est.order_independent();
+    let grids_wanted = mode != Coordination::None || d > 0 || (certify && est.order_independent());
     let alone: Vec<ValueGrid> = if fleet.first.is_none() && grids_wanted {
         plans.iter().map(|p| p.grid.clone()).collect()
     } else {
@@ -212,7 +214,9 @@ pub fn coordinate(
     let mut by_step = fleet.by_step(&path_slices(&plans), &order);
     cancel.check()?;
     let mut report = None;
-    let bound = if fleet.first.is_some() {
+    let bound = if !certify {
+        None
+    } else if fleet.first.is_some() {
         let value: f64 = by_step.iter().sum();
         Some(Bound::new(
             value,

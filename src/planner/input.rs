@@ -32,6 +32,8 @@ pub struct PlanInput {
     pub(crate) explain: bool,
     pub(crate) min_separation: usize,
     pub(crate) joint: JointSettings,
+    /// Compute the certificate (exact plans).
+    pub(crate) certify: bool,
 }
 
 fn finite(field: impl Fn() -> String, v: f64) -> Result<f64, ValidationError> {
@@ -75,6 +77,24 @@ pub(crate) fn check_estimator(
         ));
     }
     Ok(estimator)
+}
+
+/// Whether to certify the plan (true by default), refused `false` with
+/// `joint` coordination: its rounds tighten the certificate and stop on
+/// its gap.
+pub(crate) fn check_certify(
+    field: &str,
+    certify: Option<bool>,
+    coordination: Coordination,
+) -> Result<bool, ValidationError> {
+    let certify = certify.unwrap_or(true);
+    if !certify && coordination == Coordination::Joint {
+        return Err(ValidationError::new(
+            field,
+            "joint coordination improves its plan until its certificate's gap is small: it cannot skip the certificate",
+        ));
+    }
+    Ok(certify)
 }
 
 impl PlanInput {
@@ -226,6 +246,8 @@ impl PlanInput {
         }
         let estimator = check_estimator("estimator", req.estimator.unwrap_or_default(), s)?;
         let objective = check_objective("objective", req.objective, estimator)?;
+        let coordination = req.coordination.unwrap_or_default();
+        let certify = check_certify("certify", req.certify, coordination)?;
         Ok(PlanInput {
             min_separation,
             ids,
@@ -235,11 +257,12 @@ impl PlanInput {
             history: past,
             horizon,
             estimator,
-            coordination: req.coordination.unwrap_or_default(),
+            coordination,
             objective,
             observed: req.observed.unwrap_or_default(),
             explain: req.explain.unwrap_or(false),
             joint,
+            certify,
         })
     }
 }

@@ -192,7 +192,13 @@ impl Planner {
         let est = self.estimator(input, cancel)?;
         cancel.check()?;
         let result = est.with_fleet(s, input, cancel, |fleet| {
-            coordinate(fleet, input.coordination, input.joint, started)
+            coordinate(
+                fleet,
+                input.coordination,
+                input.joint,
+                input.certify,
+                started,
+            )
         })?;
         let cell_out = |c: Cell| {
             let p = s.centre(c);

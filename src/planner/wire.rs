@@ -206,6 +206,13 @@ pub struct PlanRequest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(value_type = Option<u32>, minimum = 1)]
     pub budget_ms: Option<Integer>,
+    /// Certify the plan: with the `exact` estimator the response carries
+    /// `bound`, an upper bound on the best joint plan (true by default).
+    /// `false` skips the certificate's work and leaves `bound` out; the
+    /// paths and values are the same. Refused with `coordination: joint`,
+    /// whose rounds are the certificate's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub certify: Option<bool>,
 }
 
 /// A lattice cell and its centre.

@@ -339,3 +339,75 @@ async fn plans_on_the_async_worker_answer_as_on_the_pool() {
         assert_eq!(untimed(a), untimed(b), "step {step}");
     }
 }
+
+/// `"certify": false` leaves the bound out and changes nothing else (for
+/// both objectives and every coordination but `joint`, which refuses it);
+/// sessions take it at creation and per step.
+#[tokio::test]
+async fn certify_false_skips_the_bound_and_nothing_else() {
+    let app = spawn_app().await;
+    for objective in ["detections", "first_detections"] {
+        for coordination in ["none", "priority", "iterated"] {
+            let mut req = plan_request();
+            req["objective"] = json!(objective);
+            req["coordination"] = json!(coordination);
+            let certified = untimed(json_body(app.plan(&req).await, StatusCode::OK).await);
+            req["certify"] = json!(false);
+            let plain = untimed(json_body(app.plan(&req).await, StatusCode::OK).await);
+            assert!(
+                certified["bound"]["upper"].as_f64().is_some(),
+                "{certified}"
+            );
+            assert!(plain.get("bound").is_none(), "{plain}");
+            let mut without = certified.clone();
+            without.as_object_mut().unwrap().remove("bound");
+            assert_eq!(plain, without, "{objective}, {coordination}");
+        }
+    }
+    let mut joint = plan_request();
+    joint["coordination"] = json!("joint");
+    joint["certify"] = json!(false);
+    crate::helpers::assert_validation(app.plan(&joint).await, "certify").await;
+
+    // Sessions: off at creation, on again for one step.
+    let res = app
+        .post_json(
+            "/v1/sessions",
+            &json!({"scenario_id": "paper-v10", "certify": false}),
+        )
+        .await;
+    let id = json_body(res, StatusCode::CREATED).await["id"]
+        .as_str()
+        .unwrap()
+        .to_owned();
+    let step = |certify: Option<bool>| {
+        let mut body = json!({"sensors": plan_request()["sensors"]});
+        if let Some(c) = certify {
+            body["certify"] = json!(c);
+        }
+        body
+    };
+    let first = json_body(
+        app.post_json(&format!("/v1/sessions/{id}/step"), &step(None))
+            .await,
+        StatusCode::OK,
+    )
+    .await;
+    assert!(first.get("bound").is_none(), "{first}");
+    let second = json_body(
+        app.post_json(&format!("/v1/sessions/{id}/step"), &step(Some(true)))
+            .await,
+        StatusCode::OK,
+    )
+    .await;
+    assert!(second["bound"]["upper"].as_f64().is_some(), "{second}");
+    crate::helpers::assert_validation(
+        app.post_json(
+            "/v1/sessions",
+            &json!({"scenario_id": "paper-v10", "coordination": "joint", "certify": false}),
+        )
+        .await,
+        "certify",
+    )
+    .await;
+}

@@ -64,6 +64,10 @@ macro_rules! plan_request_with {
             /// take, milliseconds (1..=1000, 20 by default).
             #[schema(value_type = Option<u32>, minimum = 1)]
             pub budget_ms: Option<Integer>,
+            /// Certify the plan (`bound`, exact plans; true by default):
+            /// `false` skips the certificate's work and leaves `bound`
+            /// out; refused with `coordination: joint`.
+            pub certify: Option<bool>,
         }
     };
 }
@@ -96,8 +100,8 @@ pub enum InlinePlanRequest {
 
 plan_request_with!(
     /// Body of `POST /v1/scenarios/{id}/evaluate`: a plan request's fields
-    /// (its `coordination`, `explain`, `gap_target` and `budget_ms` play no
-    /// part) and the paths to score.
+    /// (its `coordination`, `explain`, `gap_target`, `budget_ms` and
+    /// `certify` play no part) and the paths to score.
     EvaluateBody,
     /// One path per sensor.
     #[schema(min_items = 1)]

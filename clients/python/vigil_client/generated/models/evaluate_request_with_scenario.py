@@ -34,6 +34,9 @@ class EvaluateRequestWithScenario:
         sensors (list[SensorIn]): Sensors now.
         budget_ms (int | None | Unset): With `coordination: joint`: the most time the plan may
             take, milliseconds (1..=1000, 20 by default).
+        certify (bool | None | Unset): Certify the plan (`bound`, exact plans; true by default):
+            `false` skips the certificate's work and leaves `bound`
+            out; refused with `coordination: joint`.
         coordination (Coordination | None | Unset):
         estimator (EstimatorKind | None | Unset):
         explain (bool | None | Unset): Include the search values in the response.
@@ -55,6 +58,7 @@ class EvaluateRequestWithScenario:
     scenario: ScenarioSpec
     sensors: list[SensorIn]
     budget_ms: int | None | Unset = UNSET
+    certify: bool | None | Unset = UNSET
     coordination: Coordination | None | Unset = UNSET
     estimator: EstimatorKind | None | Unset = UNSET
     explain: bool | None | Unset = UNSET
@@ -84,6 +88,12 @@ class EvaluateRequestWithScenario:
             budget_ms = UNSET
         else:
             budget_ms = self.budget_ms
+
+        certify: bool | None | Unset
+        if isinstance(self.certify, Unset):
+            certify = UNSET
+        else:
+            certify = self.certify
 
         coordination: None | str | Unset
         if isinstance(self.coordination, Unset):
@@ -175,6 +185,8 @@ class EvaluateRequestWithScenario:
         )
         if budget_ms is not UNSET:
             field_dict["budget_ms"] = budget_ms
+        if certify is not UNSET:
+            field_dict["certify"] = certify
         if coordination is not UNSET:
             field_dict["coordination"] = coordination
         if estimator is not UNSET:
@@ -231,6 +243,15 @@ class EvaluateRequestWithScenario:
             return cast(int | None | Unset, data)
 
         budget_ms = _parse_budget_ms(d.pop("budget_ms", UNSET))
+
+        def _parse_certify(data: object) -> bool | None | Unset:
+            if data is None:
+                return data
+            if isinstance(data, Unset):
+                return data
+            return cast(bool | None | Unset, data)
+
+        certify = _parse_certify(d.pop("certify", UNSET))
 
         def _parse_coordination(data: object) -> Coordination | None | Unset:
             if data is None:
@@ -379,6 +400,7 @@ class EvaluateRequestWithScenario:
             scenario=scenario,
             sensors=sensors,
             budget_ms=budget_ms,
+            certify=certify,
             coordination=coordination,
             estimator=estimator,
             explain=explain,

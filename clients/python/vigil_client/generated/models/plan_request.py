@@ -31,6 +31,11 @@ class PlanRequest:
         budget_ms (int | None | Unset): With `coordination: joint`: the most time the plan may take,
             milliseconds (1..=1000, 20 by default), counted from its start and
             within the server's time limit. Other coordinations ignore it.
+        certify (bool | None | Unset): Certify the plan: with the `exact` estimator the response carries
+            `bound`, an upper bound on the best joint plan (true by default).
+            `false` skips the certificate's work and leaves `bound` out; the
+            paths and values are the same. Refused with `coordination: joint`,
+            whose rounds are the certificate's.
         coordination (Coordination | None | Unset):
         estimator (EstimatorKind | None | Unset):
         explain (bool | None | Unset): Include the search values in the response.
@@ -50,6 +55,7 @@ class PlanRequest:
 
     sensors: list[SensorIn]
     budget_ms: int | None | Unset = UNSET
+    certify: bool | None | Unset = UNSET
     coordination: Coordination | None | Unset = UNSET
     estimator: EstimatorKind | None | Unset = UNSET
     explain: bool | None | Unset = UNSET
@@ -72,6 +78,12 @@ class PlanRequest:
             budget_ms = UNSET
         else:
             budget_ms = self.budget_ms
+
+        certify: bool | None | Unset
+        if isinstance(self.certify, Unset):
+            certify = UNSET
+        else:
+            certify = self.certify
 
         coordination: None | str | Unset
         if isinstance(self.coordination, Unset):
@@ -161,6 +173,8 @@ class PlanRequest:
         )
         if budget_ms is not UNSET:
             field_dict["budget_ms"] = budget_ms
+        if certify is not UNSET:
+            field_dict["certify"] = certify
         if coordination is not UNSET:
             field_dict["coordination"] = coordination
         if estimator is not UNSET:
@@ -206,6 +220,15 @@ class PlanRequest:
             return cast(int | None | Unset, data)
 
         budget_ms = _parse_budget_ms(d.pop("budget_ms", UNSET))
+
+        def _parse_certify(data: object) -> bool | None | Unset:
+            if data is None:
+                return data
+            if isinstance(data, Unset):
+                return data
+            return cast(bool | None | Unset, data)
+
+        certify = _parse_certify(d.pop("certify", UNSET))
 
         def _parse_coordination(data: object) -> Coordination | None | Unset:
             if data is None:
@@ -352,6 +375,7 @@ class PlanRequest:
         plan_request = cls(
             sensors=sensors,
             budget_ms=budget_ms,
+            certify=certify,
             coordination=coordination,
             estimator=estimator,
             explain=explain,

@@ -31,6 +31,9 @@ class PlanRequestById:
         sensors (list[SensorIn]): Sensors now.
         budget_ms (int | None | Unset): With `coordination: joint`: the most time the plan may
             take, milliseconds (1..=1000, 20 by default).
+        certify (bool | None | Unset): Certify the plan (`bound`, exact plans; true by default):
+            `false` skips the certificate's work and leaves `bound`
+            out; refused with `coordination: joint`.
         coordination (Coordination | None | Unset):
         estimator (EstimatorKind | None | Unset):
         explain (bool | None | Unset): Include the search values in the response.
@@ -51,6 +54,7 @@ class PlanRequestById:
     scenario_id: str
     sensors: list[SensorIn]
     budget_ms: int | None | Unset = UNSET
+    certify: bool | None | Unset = UNSET
     coordination: Coordination | None | Unset = UNSET
     estimator: EstimatorKind | None | Unset = UNSET
     explain: bool | None | Unset = UNSET
@@ -75,6 +79,12 @@ class PlanRequestById:
             budget_ms = UNSET
         else:
             budget_ms = self.budget_ms
+
+        certify: bool | None | Unset
+        if isinstance(self.certify, Unset):
+            certify = UNSET
+        else:
+            certify = self.certify
 
         coordination: None | str | Unset
         if isinstance(self.coordination, Unset):
@@ -165,6 +175,8 @@ class PlanRequestById:
         )
         if budget_ms is not UNSET:
             field_dict["budget_ms"] = budget_ms
+        if certify is not UNSET:
+            field_dict["certify"] = certify
         if coordination is not UNSET:
             field_dict["coordination"] = coordination
         if estimator is not UNSET:
@@ -212,6 +224,15 @@ class PlanRequestById:
             return cast(int | None | Unset, data)
 
         budget_ms = _parse_budget_ms(d.pop("budget_ms", UNSET))
+
+        def _parse_certify(data: object) -> bool | None | Unset:
+            if data is None:
+                return data
+            if isinstance(data, Unset):
+                return data
+            return cast(bool | None | Unset, data)
+
+        certify = _parse_certify(d.pop("certify", UNSET))
 
         def _parse_coordination(data: object) -> Coordination | None | Unset:
             if data is None:
@@ -359,6 +380,7 @@ class PlanRequestById:
             scenario_id=scenario_id,
             sensors=sensors,
             budget_ms=budget_ms,
+            certify=certify,
             coordination=coordination,
             estimator=estimator,
             explain=explain,

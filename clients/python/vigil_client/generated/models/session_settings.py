@@ -23,6 +23,8 @@ class SessionSettings:
     `history_steps`.
 
         Attributes:
+            certify (bool | None | Unset): Certify each step's plan (true by default; see the plan request's
+                `certify`).
             coordination (Coordination | None | Unset):
             estimator (EstimatorKind | None | Unset):
             history_steps (int | None | Unset): Steps of history kept (0..=32, 16 by default): the sensors' past
@@ -34,6 +36,7 @@ class SessionSettings:
             observed (None | Observed | Unset):
     """
 
+    certify: bool | None | Unset = UNSET
     coordination: Coordination | None | Unset = UNSET
     estimator: EstimatorKind | None | Unset = UNSET
     history_steps: int | None | Unset = UNSET
@@ -43,6 +46,12 @@ class SessionSettings:
     observed: None | Observed | Unset = UNSET
 
     def to_dict(self) -> dict[str, Any]:
+        certify: bool | None | Unset
+        if isinstance(self.certify, Unset):
+            certify = UNSET
+        else:
+            certify = self.certify
+
         coordination: None | str | Unset
         if isinstance(self.coordination, Unset):
             coordination = UNSET
@@ -96,6 +105,8 @@ class SessionSettings:
         field_dict: dict[str, Any] = {}
 
         field_dict.update({})
+        if certify is not UNSET:
+            field_dict["certify"] = certify
         if coordination is not UNSET:
             field_dict["coordination"] = coordination
         if estimator is not UNSET:
@@ -116,6 +127,15 @@ class SessionSettings:
     @classmethod
     def from_dict(cls: type[T], src_dict: Mapping[str, Any]) -> T:
         d = dict(src_dict)
+
+        def _parse_certify(data: object) -> bool | None | Unset:
+            if data is None:
+                return data
+            if isinstance(data, Unset):
+                return data
+            return cast(bool | None | Unset, data)
+
+        certify = _parse_certify(d.pop("certify", UNSET))
 
         def _parse_coordination(data: object) -> Coordination | None | Unset:
             if data is None:
@@ -213,6 +233,7 @@ class SessionSettings:
         observed = _parse_observed(d.pop("observed", UNSET))
 
         session_settings = cls(
+            certify=certify,
             coordination=coordination,
             estimator=estimator,
             history_steps=history_steps,

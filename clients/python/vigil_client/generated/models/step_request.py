@@ -28,6 +28,7 @@ class StepRequest:
         sensors (list[SensorIn]): Sensors now.
         budget_ms (int | None | Unset): With `coordination: joint`: the most time the step's plan may take,
             milliseconds (1..=1000, 20 by default).
+        certify (bool | None | Unset): Certify this step's plan; the session's setting by default.
         coordination (Coordination | None | Unset):
         detections (list[TargetIn] | Unset): Targets detected this step (by any sensor), their position and
             displacement per step now; with an `id` when the client tracks
@@ -43,6 +44,7 @@ class StepRequest:
 
     sensors: list[SensorIn]
     budget_ms: int | None | Unset = UNSET
+    certify: bool | None | Unset = UNSET
     coordination: Coordination | None | Unset = UNSET
     detections: list[TargetIn] | Unset = UNSET
     estimator: EstimatorKind | None | Unset = UNSET
@@ -63,6 +65,12 @@ class StepRequest:
             budget_ms = UNSET
         else:
             budget_ms = self.budget_ms
+
+        certify: bool | None | Unset
+        if isinstance(self.certify, Unset):
+            certify = UNSET
+        else:
+            certify = self.certify
 
         coordination: None | str | Unset
         if isinstance(self.coordination, Unset):
@@ -128,6 +136,8 @@ class StepRequest:
         )
         if budget_ms is not UNSET:
             field_dict["budget_ms"] = budget_ms
+        if certify is not UNSET:
+            field_dict["certify"] = certify
         if coordination is not UNSET:
             field_dict["coordination"] = coordination
         if detections is not UNSET:
@@ -168,6 +178,15 @@ class StepRequest:
             return cast(int | None | Unset, data)
 
         budget_ms = _parse_budget_ms(d.pop("budget_ms", UNSET))
+
+        def _parse_certify(data: object) -> bool | None | Unset:
+            if data is None:
+                return data
+            if isinstance(data, Unset):
+                return data
+            return cast(bool | None | Unset, data)
+
+        certify = _parse_certify(d.pop("certify", UNSET))
 
         def _parse_coordination(data: object) -> Coordination | None | Unset:
             if data is None:
@@ -268,6 +287,7 @@ class StepRequest:
         step_request = cls(
             sensors=sensors,
             budget_ms=budget_ms,
+            certify=certify,
             coordination=coordination,
             detections=detections,
             estimator=estimator,

@@ -119,8 +119,8 @@ def sync_detailed(
     Args:
         id (str):
         body (EvaluateBody): Body of `POST /v1/scenarios/{id}/evaluate`: a plan request's fields
-            (its `coordination`, `explain`, `gap_target` and `budget_ms` play no
-            part) and the paths to score.
+            (its `coordination`, `explain`, `gap_target`, `budget_ms` and
+            `certify` play no part) and the paths to score.
 
     Raises:
         errors.UnexpectedStatus: If the server returns an undocumented status code and Client.raise_on_unexpected_status is True.
@@ -166,8 +166,8 @@ def sync(
     Args:
         id (str):
         body (EvaluateBody): Body of `POST /v1/scenarios/{id}/evaluate`: a plan request's fields
-            (its `coordination`, `explain`, `gap_target` and `budget_ms` play no
-            part) and the paths to score.
+            (its `coordination`, `explain`, `gap_target`, `budget_ms` and
+            `certify` play no part) and the paths to score.
 
     Raises:
         errors.UnexpectedStatus: If the server returns an undocumented status code and Client.raise_on_unexpected_status is True.
@@ -208,8 +208,8 @@ async def asyncio_detailed(
     Args:
         id (str):
         body (EvaluateBody): Body of `POST /v1/scenarios/{id}/evaluate`: a plan request's fields
-            (its `coordination`, `explain`, `gap_target` and `budget_ms` play no
-            part) and the paths to score.
+            (its `coordination`, `explain`, `gap_target`, `budget_ms` and
+            `certify` play no part) and the paths to score.
 
     Raises:
         errors.UnexpectedStatus: If the server returns an undocumented status code and Client.raise_on_unexpected_status is True.
@@ -253,8 +253,8 @@ async def asyncio(
     Args:
         id (str):
         body (EvaluateBody): Body of `POST /v1/scenarios/{id}/evaluate`: a plan request's fields
-            (its `coordination`, `explain`, `gap_target` and `budget_ms` play no
-            part) and the paths to score.
+            (its `coordination`, `explain`, `gap_target`, `budget_ms` and
+            `certify` play no part) and the paths to score.
 
     Raises:
         errors.UnexpectedStatus: If the server returns an undocumented status code and Client.raise_on_unexpected_status is True.
