@@ -62,8 +62,24 @@ UNSCHEMATISABLE = [
         "a name must be one of the sensor types of the scenario named by the path or body",
     ),
     (
-        r"^(sensors\[\d+\]|history\[\d+\]\[\d+\]): cell .* is in a no-go zone",
-        "a position must lie outside the no-go rectangles of the scenario named by the path or body",
+        r"^(sensors\[\d+\]|history\[\d+\]\[\d+\]): cell .* is in (a no-go zone|a building)",
+        "a position must lie outside the no-go rectangles and (for a ground type) the buildings of the scenario named by the path or body",
+    ),
+    (
+        r"^(scenario\.)?obstacles\[\d+\]\.polygon: ",
+        "geometry: a polygon's vertices must be distinct, turn one way, wind once, and meet the zone given in another field",
+    ),
+    (
+        r"^(scenario\.)?sources\[\d+\]: (lies inside a building|every direction of its cone meets a building)",
+        "geometry: a source's position and cone against the obstacles, given in another field",
+    ),
+    (
+        r"^estimator: the paper estimator has no notion of sight lines",
+        "the paper estimator is refused for a scenario with obstacles, named by the path or body",
+    ),
+    (
+        r"^certify: joint coordination ",
+        "a relation between two fields (`certify: false` with `coordination: joint`)",
     ),
     (
         r"^(scenario\.)?no_go\[\d+\]: [xy]0 must be < [xy]1",
@@ -102,7 +118,7 @@ UNSCHEMATISABLE = [
         "a path's length is the horizon, given in another field or by the scenario",
     ),
     (
-        r"^paths\[\d+\]\.path\[\d+\]: \(col -?\d+, row -?\d+\) (is off the lattice|is in a no-go zone|cannot be reached)",
+        r"^paths\[\d+\]\.path\[\d+\]: \(col -?\d+, row -?\d+\) (is off the lattice|is in a no-go zone|is in a building|cannot be reached)",
         "a cell must lie on the lattice and outside the no-go zones of the scenario named by the path or body",
     ),
     (
