@@ -210,6 +210,25 @@ impl Polygon {
         self.edges.iter().all(|h| h.slack(p) >= -self.eps)
     }
 
+    /// The closed interval of `x` where the horizontal line at `y` lies in
+    /// the closed polygon (within the tolerance of
+    /// [`Polygon::contains_closed`], by the same inequalities), or `None`.
+    pub fn row_span(&self, y: f64) -> Option<(f64, f64)> {
+        let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+        for h in &self.edges {
+            // n.x·x + n.y·y ≤ c + eps.
+            let rhs = h.c + self.eps - h.n.y * y;
+            if h.n.x > 0.0 {
+                hi = hi.min(rhs / h.n.x);
+            } else if h.n.x < 0.0 {
+                lo = lo.max(rhs / h.n.x);
+            } else if rhs < 0.0 {
+                return None;
+            }
+        }
+        (lo <= hi).then_some((lo, hi))
+    }
+
     /// Area of the part of the polygon inside `rect`.
     pub fn area_within(&self, rect: &Rect) -> f64 {
         let mut poly = self.vertices.clone();

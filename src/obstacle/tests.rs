@@ -253,3 +253,20 @@ fn area_within_clips_to_the_rectangle() {
     assert!((poly.area_within(&r) - 100.0).abs() < 1e-9);
     assert_eq!(square(-20.0, -20.0, -10.0, -10.0).area_within(&r), 0.0);
 }
+
+proptest! {
+    /// A row's span holds exactly the points of the row in the closed
+    /// polygon, away from its ends.
+    #[test]
+    fn row_spans_match_closed_containment(poly in polygons(), y in 0.0..100.0f64) {
+        let span = poly.row_span(y);
+        for i in 0..=400 {
+            let x = f64::from(i) * 0.25;
+            if span.is_some_and(|(a, b)| (x - a).abs() < 1e-6 || (x - b).abs() < 1e-6) {
+                continue;
+            }
+            let inside = span.is_some_and(|(a, b)| a <= x && x <= b);
+            prop_assert_eq!(inside, poly.contains_closed(Point::new(x, y)), "x = {}", x);
+        }
+    }
+}

@@ -17,7 +17,7 @@ use crate::limits::{
     MAX_CELLS, MAX_NAME_CHARS, MAX_POPULATION, MAX_RAYS_PER_PI, MAX_SOURCES, MIN_RAYS_PER_PI,
     OBSTACLE_STATS_RAYS_PER_PI,
 };
-use crate::obstacle::{Obstacles, Sight};
+use crate::obstacle::{ObstacleKind, Obstacles, Sight};
 
 mod builtins;
 mod input;
@@ -250,19 +250,7 @@ impl Scenario {
         )?;
         let blocked =
             sensor::blocked_cells(spec.no_go.as_deref().unwrap_or(&[]), cols, rows, cell_size)?;
-        let in_building = if obstacles.in_building_anywhere() {
-            (0..rows)
-                .flat_map(|row| (0..cols).map(move |col| (col, row)))
-                .map(|(col, row)| {
-                    obstacles.in_building(Point::new(
-                        (f64::from(col) + 0.5) * cell_size,
-                        (f64::from(row) + 0.5) * cell_size,
-                    ))
-                })
-                .collect()
-        } else {
-            Vec::new()
-        };
+        let in_building = building_cells(&obstacles, cols, rows, cell_size);
         if fleet.fovs.len() > 1
             && cols as u64 * rows as u64 * fleet.fovs.len() as u64 > MAX_CELL_STATS as u64
         {
@@ -608,6 +596,49 @@ impl Scenario {
     }
 }
 
+/// Row-major: true for a cell whose centre lies in a building (closed);
+/// empty without buildings. Row by row, each building marks the columns
+/// of its span at the row's centre line, so the work is the rows and the
+/// cells the buildings cover, not every cell times every building.
+fn building_cells(obstacles: &Obstacles, cols: i32, rows: i32, cell_size: f64) -> Vec<bool> {
+    if !obstacles.in_building_anywhere() {
+        return Vec::new();
+    }
+    let mut marked = vec![false; cols as usize * rows as usize];
+    for ob in obstacles.list() {
+        if ob.kind != ObstacleKind::Building {
+            continue;
+        }
+        let b = ob.polygon.bbox();
+        let first = ((b.y0 / cell_size - 0.5).floor().max(0.0) as i64).min(i64::from(rows));
+        let last = ((b.y1 / cell_size - 0.5).ceil().max(-1.0) as i64).min(i64::from(rows) - 1);
+        for row in first..=last {
+            let y = (row as f64 + 0.5) * cell_size;
+            let Some((x0, x1)) = ob.polygon.row_span(y) else {
+                continue;
+            };
+            // Columns whose centre (c + ½)·size lies in [x0, x1]: those
+            // within a column of either end are checked against the
+            // polygon itself (the divisions round), the rest are inside.
+            let a = (x0 / cell_size - 0.5).ceil();
+            let b = (x1 / cell_size - 0.5).floor();
+            let c0 = (a - 1.0).max(0.0) as i64;
+            let c1 = (b + 1.0).min(f64::from(cols) - 1.0) as i64;
+            for col in c0..=c1 {
+                let near_end = col as f64 <= a || col as f64 >= b;
+                if !near_end
+                    || ob
+                        .polygon
+                        .contains_closed(Point::new((col as f64 + 0.5) * cell_size, y))
+                {
+                    marked[row as usize * cols as usize + col as usize] = true;
+                }
+            }
+        }
+    }
+    marked
+}
+
 /// Refuses source `i` when no direction of its cone reaches the zone's
 /// interior before a building ends its flight (a source inside a
 /// building among them), checked on a grid of
@@ -734,5 +765,33 @@ mod tests {
                 y1: 35.0
             }
         );
+    }
+
+    /// The building cells, marked row by row, are exactly the cells whose
+    /// centre the closed polygons hold (site-campus, and buildings whose
+    /// edges pass through cell centres).
+    #[test]
+    fn building_cells_are_the_centres_in_buildings() {
+        let mut campus = super::site_campus_spec();
+        campus
+            .obstacles
+            .as_mut()
+            .expect("obstacles")
+            .push(ObstacleSpec {
+                polygon: vec![[15.0, 15.0], [55.0, 15.0], [55.0, 35.0], [15.0, 55.0]],
+                kind: None,
+            });
+        let s = Scenario::new(campus).expect("valid");
+        let robot = s.type_index("robot").expect("robot");
+        let drone = s.type_index("drone").expect("drone");
+        let mut blocked = 0;
+        for i in 0..s.cell_count() {
+            let c = s.cell_at(i);
+            let inside = s.obstacles.in_building(s.centre(c));
+            assert_eq!(s.blocked_for(robot, c).is_some(), inside, "{c:?}");
+            assert!(s.blocked_for(drone, c).is_none());
+            blocked += usize::from(inside);
+        }
+        assert!(blocked > 100, "{blocked}");
     }
 }
