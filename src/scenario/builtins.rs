@@ -261,3 +261,36 @@ pub fn builtins() -> Vec<Scenario> {
     .map(|(spec, id)| Scenario::build(spec, Some(id)).expect("built-in specs are valid"))
     .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The building cells, marked row by row, are exactly the cells whose
+    /// centre the closed polygons hold (site-campus, and buildings whose
+    /// edges pass through cell centres).
+    #[test]
+    fn building_cells_are_the_centres_in_buildings() {
+        let mut campus = site_campus_spec();
+        campus
+            .obstacles
+            .as_mut()
+            .expect("obstacles")
+            .push(ObstacleSpec {
+                polygon: vec![[15.0, 15.0], [55.0, 15.0], [55.0, 35.0], [15.0, 55.0]],
+                kind: None,
+            });
+        let s = Scenario::new(campus).expect("valid");
+        let robot = s.type_index("robot").expect("robot");
+        let drone = s.type_index("drone").expect("drone");
+        let mut blocked = 0;
+        for i in 0..s.cell_count() {
+            let c = s.cell_at(i);
+            let inside = s.obstacles.in_building(s.centre(c));
+            assert_eq!(s.blocked_for(robot, c).is_some(), inside, "{c:?}");
+            assert!(s.blocked_for(drone, c).is_none());
+            blocked += usize::from(inside);
+        }
+        assert!(blocked > 100, "{blocked}");
+    }
+}
