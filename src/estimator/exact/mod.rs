@@ -408,6 +408,22 @@ impl<'a> ExactEstimator<'a> {
                 + self.unseen_by_rays(k, ty.fov_slot, &fk, t, &excluded))
     }
 
+    /// A box holding every field of view `sensor` may have at step `t`
+    /// from `start`: the start's, grown by the cells it may move (and one
+    /// more, for rounding).
+    fn reach(&self, sensor: usize, start: Cell, t: usize) -> crate::geometry::Rect {
+        let s = self.scenario;
+        let ty = self.types[sensor];
+        let r = s.fov_region_of(ty, start).rect;
+        let m = s.cell_size * (s.types[ty].speed * t + 1) as f64;
+        crate::geometry::Rect {
+            x0: r.x0 - m,
+            y0: r.y0 - m,
+            x1: r.x1 + m,
+            y1: r.y1 + m,
+        }
+    }
+
     /// The sensor's window at step `t`, when it holds `k`'s block.
     fn block(&self, sensor: usize, k: Cell, t: usize) -> Option<&Window> {
         let (grid, win) = self.window_of(sensor, t)?;
@@ -505,16 +521,7 @@ impl Estimator for ExactEstimator<'_> {
         // Only targets some field of view of the reach can hold: every one
         // lies within the start's, moved by at most `ti` cells (a cell more
         // for rounding). Most of a zone's targets are far from one sensor.
-        let reach = {
-            let r = s.fov_region_of(self.types[sensor], start).rect;
-            let m = s.cell_size * f64::from(ti + 1);
-            crate::geometry::Rect {
-                x0: r.x0 - m,
-                y0: r.y0 - m,
-                x1: r.x1 + m,
-                y1: r.y1 + m,
-            }
-        };
+        let reach = self.reach(sensor, start, t);
         for p in self.known.iter().map(|tg| tg.at(t)) {
             if !s.in_zone(p) || !reach.contains(p) {
                 continue;

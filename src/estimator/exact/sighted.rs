@@ -91,18 +91,9 @@ impl ExactEstimator<'_> {
         let s = self.scenario;
         let ty = self.types[sensor];
         // Every look that may meet a field of view of the reach.
-        let reach = {
-            let r = s.fov_region_of(ty, start);
-            let m = s.cell_size * (s.types[ty].speed * t + 1) as f64;
-            crate::geometry::Region {
-                rect: crate::geometry::Rect {
-                    x0: r.rect.x0 - m,
-                    y0: r.rect.y0 - m,
-                    x1: r.rect.x1 + m,
-                    y1: r.rect.y1 + m,
-                },
-                disk: None,
-            }
+        let reach = crate::geometry::Region {
+            rect: self.reach(sensor, start, t),
+            disk: None,
         };
         let near = self.excluded_sights(excluded, &reach);
         let mut scratch = Scratch::default();
@@ -141,9 +132,9 @@ impl ExactEstimator<'_> {
         let known: f64 = self
             .known
             .iter()
-            .filter(|tg| fk.contains(tg.at(t)) && self.known_alive(tg, t))
-            .map(|tg| tg.at(t))
-            .filter(|&p| sees(&sight, p))
+            .map(|tg| (tg, tg.at(t)))
+            .filter(|&(tg, p)| fk.contains(p) && self.known_alive(tg, t) && sees(&sight, p))
+            .map(|(_, p)| p)
             .map(|p| {
                 near.iter()
                     .filter(|(x, v)| x.region.contains(p) && sees(v, p))
