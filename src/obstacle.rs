@@ -382,30 +382,20 @@ impl Obstacles {
     /// the distance at which the ray first enters a building's interior
     /// (0 when it starts inside one), or infinity.
     pub fn stop(&self, o: Point, d: Point) -> f64 {
-        let mut stop = f64::INFINITY;
-        for ob in &self.list {
-            if ob.kind != ObstacleKind::Building {
-                continue;
-            }
-            if let Some((t0, t1)) = ob.polygon.line_interior(o, d)
-                && t1 > 0.0
-            {
-                stop = stop.min(t0.max(0.0));
-            }
-        }
-        stop
+        first_entry(
+            self.list
+                .iter()
+                .filter(|ob| ob.kind == ObstacleKind::Building),
+            o,
+            d,
+        )
     }
 
     /// How far a sight line from `p` along the unit direction `d` runs
     /// before it enters an obstacle's interior (0 from inside one), or
     /// infinity.
     pub fn sight_reach(&self, p: Point, d: Point) -> f64 {
-        self.list
-            .iter()
-            .filter_map(|ob| ob.polygon.line_interior(p, d))
-            .filter(|&(_, t1)| t1 > 0.0)
-            .map(|(t0, _)| t0.max(0.0))
-            .fold(f64::INFINITY, f64::min)
+        first_entry(self.list.iter(), p, d)
     }
 
     /// True when the open segment `(p, q)` meets no obstacle's interior.
@@ -434,6 +424,17 @@ impl Obstacles {
             .collect();
         (!shadows.is_empty()).then_some(Sight { from: p, shadows })
     }
+}
+
+/// The distance along the ray `o + t·d` (`t ≥ 0`) at which it first
+/// enters one of `obstacles`' interiors (0 when it starts inside one), or
+/// infinity.
+fn first_entry<'a>(obstacles: impl Iterator<Item = &'a Obstacle>, o: Point, d: Point) -> f64 {
+    obstacles
+        .filter_map(|ob| ob.polygon.line_interior(o, d))
+        .filter(|&(_, t1)| t1 > 0.0)
+        .map(|(t0, _)| t0.max(0.0))
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// The shadows that hide points from one viewpoint: what a ground sensor's
