@@ -400,3 +400,101 @@ fn values_match_a_brute_force_integral() {
         );
     }
 }
+
+/// The first-detections search scores a path by its stops' gains: on the
+/// yard, where buildings and the hedge cut many rays of a camera's view
+/// into several visible pieces, a path's gains add up to what `by_step`
+/// (the objective itself) gives its looks, alone and over the other
+/// sensors' paths.
+#[test]
+fn path_gains_add_up_to_the_objective() {
+    use vigil::coordination::sensor_motion;
+    use vigil::estimator::{ExactEstimator, FirstDetections, Precomputed, Situation, SourceRays};
+    let s = scenario(yard_spec());
+    let stats: Vec<Stats> = (0..s.fovs.len())
+        .map(|slot| Stats::for_slot(&s, slot))
+        .collect();
+    let rays = SourceRays::for_scenario(&s);
+    let types: Vec<usize> = TYPES.iter().map(|n| s.type_index(n).unwrap()).collect();
+    let observed: Vec<Vec<Look>> = (0..=HISTORY)
+        .map(|s_ago| {
+            track(s_ago)
+                .iter()
+                .zip(&types)
+                .map(|(&c, &ty)| s.look(ty, c))
+                .collect()
+        })
+        .collect();
+    let starts = track(0).to_vec();
+    let est = ExactEstimator::new(
+        Precomputed {
+            scenario: &s,
+            stats: &stats,
+            rays: &rays,
+            grid: None,
+        },
+        Situation {
+            observed: &observed,
+            targets: &[],
+            starts: &starts,
+            types: &types,
+            horizon: HORIZON,
+        },
+    );
+    let first = FirstDetections::new(&est);
+    let mut rng = StdRng::seed_from_u64(47);
+    let mut multi = 0;
+    for sensor in 0..3 {
+        let (start, ty) = (starts[sensor], types[sensor]);
+        let speed = s.types[ty].speed as i32;
+        for with_others in [false, true] {
+            // The others on their fixed paths, or nobody.
+            let extra: Vec<Vec<Look>> = (1..=HORIZON)
+                .map(|t| {
+                    (0..3)
+                        .filter(|&q| with_others && q != sensor)
+                        .map(|q| s.look(types[q], path(t)[q]))
+                        .collect()
+                })
+                .collect();
+            let mut grid = sensor_motion(&s, start, ty, HORIZON);
+            let cover = first.path_cover(sensor, start, &extra, &mut grid);
+            let background: f64 = first.by_step(&extra).iter().sum();
+            for _ in 0..150 {
+                let mut at = start;
+                let mut cells = Vec::new();
+                while cells.len() < HORIZON {
+                    let next = Cell {
+                        col: at.col + rng.random_range(-speed..=speed),
+                        row: at.row + rng.random_range(-speed..=speed),
+                    };
+                    if s.on_lattice(next) && s.is_free(ty, next) {
+                        cells.push(next);
+                        at = next;
+                    }
+                }
+                let offsets: Vec<(i32, i32)> = cells
+                    .iter()
+                    .map(|c| (c.col - start.col, c.row - start.row))
+                    .collect();
+                let looks: Vec<Vec<Look>> = extra
+                    .iter()
+                    .zip(&cells)
+                    .map(|(others, &c)| {
+                        let mut step = others.clone();
+                        step.push(s.look(ty, c));
+                        step
+                    })
+                    .collect();
+                let objective = first.by_step(&looks).iter().sum::<f64>() - background;
+                let gains = cover.value(&offsets);
+                assert!(
+                    (gains - objective).abs() <= 1e-9 * objective.abs().max(1.0),
+                    "sensor {sensor} on {cells:?}: gains {gains}, objective {objective}"
+                );
+                multi += usize::from(objective > 0.0);
+            }
+        }
+    }
+    assert!(multi > 100, "too few paths detect anything: {multi}");
+}

@@ -320,6 +320,7 @@ impl<'e> FirstDetections<'e> {
                 start_of: vec![0],
                 pieces: Vec::new(),
                 history_ends: Vec::new(),
+                per_key: 1,
             };
             let mut buf = Vec::new();
             for t in 1..=horizon {
@@ -339,6 +340,9 @@ impl<'e> FirstDetections<'e> {
                             let key = p.key as usize;
                             (self.history.upto(key, p.a), self.history.upto(key, p.b))
                         }));
+                    for same in stops.pieces[first..].chunk_by(|p, q| p.key == q.key) {
+                        stops.per_key = stops.per_key.max(same.len());
+                    }
                     let index = stops.index(t, (dc, dr));
                     stops.slots[index] = (stops.start_of.len() - 1) as u32;
                     stops.start_of.push(stops.pieces.len() as u32);
@@ -400,7 +404,7 @@ impl<'e> FirstDetections<'e> {
             stops,
             ends,
             alone,
-            events: RefCell::new(Vec::new()),
+            scratch: RefCell::default(),
         }
     }
 }
@@ -421,6 +425,9 @@ struct Stops {
     /// Aligned with `pieces`: `∫_{−∞}^a` and `∫_{−∞}^b` of what the history
     /// detected.
     history_ends: Vec<(f64, f64)>,
+    /// The most pieces one stop has on one key: 1 unless obstacles cut a
+    /// look's view of a ray.
+    per_key: usize,
 }
 
 impl Stops {
@@ -449,8 +456,18 @@ pub struct PathCover<'s> {
     ends: Vec<(f64, f64)>,
     /// Aligned with the stops' pieces: each one's gain alone.
     alone: Vec<f64>,
-    /// Scratch space of the sweeps.
-    events: RefCell<Vec<(f64, f64, bool)>>,
+    /// Scratch space of the gains.
+    scratch: RefCell<Sweep>,
+}
+
+/// Scratch space of one gain: the earlier pieces over one of the stop's,
+/// the pieces' ends with what the background detected up to each, and the
+/// sweep's events.
+#[derive(Debug, Default)]
+struct Sweep {
+    over: Vec<(f64, f64, f64)>,
+    known: Vec<(f64, f64)>,
+    events: Vec<(f64, f64, bool)>,
 }
 
 impl PathCover<'_> {
@@ -463,36 +480,36 @@ impl PathCover<'_> {
     }
 }
 
-impl PathGain for PathCover<'_> {
-    fn gain(&self, t: usize, at: (i32, i32), before: &[Stop]) -> f64 {
+impl PathCover<'_> {
+    /// [`PathGain::gain`] with room in `over` for every earlier piece that
+    /// may meet one of the stop's, and twice that in `known`, plus two.
+    #[inline(always)]
+    fn gain_in(
+        &self,
+        mine: std::ops::Range<usize>,
+        earlier: &mut [(usize, usize)],
+        over: &mut [(f64, f64, f64)],
+        known: &mut [(f64, f64)],
+        events: &mut Vec<(f64, f64, bool)>,
+    ) -> f64 {
         let pieces = &self.stops.pieces;
-        let mine = self.stops.stop(t, at);
-        // The earlier stops' pieces, and a cursor in each.
-        let mut earlier = [(0usize, 0usize); MAX_HORIZON];
-        for (e, &(u, off)) in earlier.iter_mut().zip(before) {
-            let r = self.stops.stop(u, off);
-            *e = (r.start, r.end);
-        }
-        let earlier = &mut earlier[..before.len()];
-        let mut over = [(0.0, 0.0, 0.0); MAX_HORIZON];
-        // Pieces' ends and what the background detected up to each.
-        let mut known = [(0.0, 0.0); 2 * MAX_HORIZON + 2];
-        let mut events = self.events.borrow_mut();
         let mut total = 0.0;
         for i in mine {
             let x = pieces[i];
             let mut n = 0;
-            // Each earlier stop holds at most one piece per key; the pieces
-            // are sorted by key, so one cursor per stop walks them once.
+            // The pieces are sorted by key, so one cursor per stop walks
+            // them once. A look holds one piece per key, or several where
+            // obstacles cut its view of the ray: every one that meets `x`.
             for (c, end) in earlier.iter_mut() {
                 while *c < *end && pieces[*c].key < x.key {
                     *c += 1;
                 }
-                if *c < *end {
-                    let q = pieces[*c];
-                    if q.key == x.key && q.b > x.a && q.a < x.b {
+                let same = pieces[*c..*end].iter().zip(&self.ends[*c..*end]);
+                for (&q, &(ga, gb)) in same.take_while(|(q, _)| q.key == x.key) {
+                    if q.b > x.a && q.a < x.b {
                         over[n] = (q.a, q.b, q.p);
-                        let (ga, gb) = self.ends[*c];
+                        // Pieces' ends and what the background detected
+                        // up to each.
                         known[2 * n] = (q.a, ga);
                         known[2 * n + 1] = (q.b, gb);
                         n += 1;
@@ -518,12 +535,40 @@ impl PathGain for PathCover<'_> {
                 let (lo, hi) = (a.max(x.a), b.min(x.b));
                 left -= d * ((hi - lo) - (g(hi) - g(lo)));
             } else {
-                detection_pieces(&over[..n], x.a, x.b, &mut events, |a, b, d| {
+                detection_pieces(&over[..n], x.a, x.b, events, |a, b, d| {
                     left -= d * ((b - a) - (g(b) - g(a)));
                 });
             }
             total += x.w * x.p * left;
         }
         total
+    }
+}
+
+impl PathGain for PathCover<'_> {
+    fn gain(&self, t: usize, at: (i32, i32), before: &[Stop]) -> f64 {
+        let mine = self.stops.stop(t, at);
+        // The earlier stops' pieces, and a cursor in each.
+        let mut earlier = [(0usize, 0usize); MAX_HORIZON];
+        for (e, &(u, off)) in earlier.iter_mut().zip(before) {
+            let r = self.stops.stop(u, off);
+            *e = (r.start, r.end);
+        }
+        let earlier = &mut earlier[..before.len()];
+        let mut scratch = self.scratch.borrow_mut();
+        let Sweep {
+            over,
+            known,
+            events,
+        } = &mut *scratch;
+        if self.stops.per_key == 1 {
+            let mut over = [(0.0, 0.0, 0.0); MAX_HORIZON];
+            let mut known = [(0.0, 0.0); 2 * MAX_HORIZON + 2];
+            return self.gain_in(mine, earlier, &mut over, &mut known, events);
+        }
+        let room = self.stops.per_key * before.len();
+        over.resize(room, (0.0, 0.0, 0.0));
+        known.resize(2 * room + 2, (0.0, 0.0));
+        self.gain_in(mine, earlier, over, known, events)
     }
 }
