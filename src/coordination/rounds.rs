@@ -44,6 +44,12 @@ pub fn best_responses(
     let n = plans.len();
     let mut rounds = 0;
     let mut changed = true;
+    // How many paths had been taken when each sensor last searched (its
+    // own included), and the count so far: a search depends only on the
+    // others' paths, so a sensor none of whose others took a path since
+    // its last search would find what it found then, and keep its path.
+    let mut searched_at: Vec<Option<usize>> = vec![None; n];
+    let mut taken = 0;
     while changed && rounds < max_rounds {
         changed = false;
         rounds += 1;
@@ -55,6 +61,9 @@ pub fn best_responses(
                 });
             }
             let i = order[rank];
+            if searched_at[i] == Some(taken) {
+                continue;
+            }
             let avoid: Vec<&[Cell]> = if d == 0 {
                 Vec::new()
             } else {
@@ -113,6 +122,7 @@ pub fn best_responses(
             {
                 plans[i] = grid_plan;
                 changed = true;
+                taken += 1;
             } else {
                 plans[i] = SensorPlan {
                     value: current_value,
@@ -121,6 +131,7 @@ pub fn best_responses(
                     grid: grid_plan.grid,
                 };
             }
+            searched_at[i] = Some(taken);
         }
     }
     Ok(Rounds {
