@@ -18,6 +18,13 @@
 //! is mostly still in view at the next), so the bound is tight and the
 //! pair programme's path is close to the best.
 //!
+//! The pair gains are the search's main cost, and many are never needed:
+//! a stop's gain is at most its lone value, so the best sum of lone values
+//! through an edge bounds every path through it. Before the pairs, the
+//! path of most lone value (one programme over single values) is scored
+//! exactly, and an edge whose lone bound falls below that score is left
+//! out: no path through it can be the best.
+//!
 //! The result is the exact optimum whenever the search finishes within its
 //! budget of gains evaluated past the pairs; otherwise it is the best path
 //! found (never below the pair programme's path, scored exactly), flagged
@@ -56,6 +63,10 @@ pub struct Bounded {
     pub evaluated: usize,
 }
 
+/// The relative margin below the lone-value path's exact score under which
+/// an edge's lone bound prunes it: far above the rounding of a sum of gains.
+const PRUNE_MARGIN: f64 = 1e-9;
+
 const ZERO: Lex = Lex {
     neg_violations: 0.0,
     value: 0.0,
@@ -77,12 +88,32 @@ pub fn best_path_bounded(grid: &ValueGrid, gain: &dyn PathGain, budget: usize) -
     };
     let violations =
         |t: usize, o: usize| f64::from(grid.violations.get((t - 1) * n + o).copied().unwrap_or(0));
+    // Without violation counts, the path of most lone value, scored
+    // exactly, prunes the pairs: a stop's gain is never above its lone
+    // value, so no path through an edge whose best lone-value path falls
+    // below that score can beat it, and the edge is left out. The margin
+    // keeps the edges of paths that tie with it to rounding (its own).
+    let mut evaluated = 0;
+    let lone = grid.violations.is_empty().then(|| LoneBounds::new(grid));
+    let lone = lone
+        .filter(|l| l.out[start] > f64::NEG_INFINITY)
+        .map(|lone| {
+            let cells = lone.best_path(grid);
+            let mut stops: Vec<Stop> = Vec::with_capacity(h);
+            let mut value = 0.0;
+            for (t, &o) in cells.iter().enumerate() {
+                value += gain.gain(t + 1, offset(o), &stops);
+                stops.push((t + 1, offset(o)));
+            }
+            evaluated += h;
+            (lone, cells, value)
+        });
     // The pair gains: `pairs[first[(t−1)·n + o] + k]` for the k-th successor
     // `s` of `o` (a stop of step t − 1, or the start) is the gain of ending
-    // step t at `s` after `o` alone (NaN where `s` has no value).
+    // step t at `s` after `o` alone (NaN where `s` has no value, or where
+    // the lone values prune the edge).
     let mut first = vec![u32::MAX; h * n];
     let mut pairs: Vec<f64> = Vec::new();
-    let mut evaluated = 0;
     for t in 1..=h {
         for o in 0..n {
             let stands = if t == 1 {
@@ -99,6 +130,14 @@ pub fn best_path_bounded(grid: &ValueGrid, gain: &dyn PathGain, budget: usize) -
                 pairs.push(match grid.values[(t - 1) * n + s] {
                     None => f64::NAN,
                     Some(alone) if t == 1 => alone,
+                    Some(alone)
+                        if lone.as_ref().is_some_and(|(bounds, _, value)| {
+                            bounds.through(t, o, s, alone)
+                                < value - PRUNE_MARGIN * value.abs().max(1.0)
+                        }) =>
+                    {
+                        f64::NAN
+                    }
                     Some(_) => {
                         evaluated += 1;
                         gain.gain(t, offset(s), &[(t - 1, offset(o))])
@@ -165,6 +204,16 @@ pub fn best_path_bounded(grid: &ValueGrid, gain: &dyn PathGain, budget: usize) -
     }
     search.best = search.score(&cells);
     search.best_cells = cells;
+    if let Some((_, cells, value)) = lone {
+        let score = Lex {
+            neg_violations: 0.0,
+            value,
+        };
+        if score.better(search.best) {
+            search.best = score;
+            search.best_cells = cells;
+        }
+    }
     search.descend(start, 0, ZERO);
     let exhaustive = !search.cut;
     let best = search.best;
@@ -197,6 +246,83 @@ pub fn best_path_bounded(grid: &ValueGrid, gain: &dyn PathGain, budget: usize) -
         exhaustive,
         upper,
         evaluated,
+    }
+}
+
+/// The best sums of lone values (the grid's) into and out of each stop:
+/// `into[t·n + o]` over steps 1..=t of paths ending at `o` at step t,
+/// `out[t·n + o]` over steps t+1..=T of paths from there (−∞ where none).
+struct LoneBounds {
+    n: usize,
+    into: Vec<f64>,
+    out: Vec<f64>,
+}
+
+impl LoneBounds {
+    fn new(grid: &ValueGrid) -> Self {
+        let mo = &*grid.motion;
+        let (h, n) = (mo.horizon, mo.side * mo.side);
+        let value = |t: usize, s: u32| grid.values[(t - 1) * n + s as usize];
+        let mut into = vec![f64::NEG_INFINITY; (h + 1) * n];
+        into[mo.start()] = 0.0;
+        for t in 1..=h {
+            for o in 0..n {
+                let here = into[(t - 1) * n + o];
+                if here == f64::NEG_INFINITY {
+                    continue;
+                }
+                for &s in mo.successors(o) {
+                    if let Some(v) = value(t, s) {
+                        let next = &mut into[t * n + s as usize];
+                        *next = next.max(here + v);
+                    }
+                }
+            }
+        }
+        let mut out = vec![f64::NEG_INFINITY; (h + 1) * n];
+        out[h * n..].fill(0.0);
+        for t in (0..h).rev() {
+            for o in 0..n {
+                let mut best = f64::NEG_INFINITY;
+                for &s in mo.successors(o) {
+                    if let Some(v) = value(t + 1, s) {
+                        best = best.max(v + out[(t + 1) * n + s as usize]);
+                    }
+                }
+                out[t * n + o] = best;
+            }
+        }
+        Self { n, into, out }
+    }
+
+    /// The most lone value of a path that ends step t at `s` (lone value
+    /// `alone`) after `o`.
+    fn through(&self, t: usize, o: usize, s: usize, alone: f64) -> f64 {
+        self.into[(t - 1) * self.n + o] + alone + self.out[t * self.n + s]
+    }
+
+    /// A path of most lone value (grid indices of steps 1..=T), the first
+    /// successor in order among equals.
+    fn best_path(&self, grid: &ValueGrid) -> Vec<usize> {
+        let mo = &*grid.motion;
+        let n = self.n;
+        let mut o = mo.start();
+        let mut cells = Vec::with_capacity(mo.horizon);
+        for t in 1..=mo.horizon {
+            let mut top = (f64::NEG_INFINITY, usize::MAX);
+            for &s in mo.successors(o) {
+                let s = s as usize;
+                if let Some(v) = grid.values[(t - 1) * n + s] {
+                    let total = v + self.out[t * n + s];
+                    if total > top.0 {
+                        top = (total, s);
+                    }
+                }
+            }
+            o = top.1;
+            cells.push(o);
+        }
+        cells
     }
 }
 
