@@ -442,6 +442,15 @@ fn path_gains_add_up_to_the_objective() {
         },
     );
     let first = FirstDetections::new(&est);
+    let cells: Vec<Vec<Cell>> = (0..3)
+        .map(|q| (1..=HORIZON).map(|t| path(t)[q]).collect())
+        .collect();
+    let paths: Vec<&[Cell]> = cells.iter().map(Vec::as_slice).collect();
+    // Every sensor's stops built, as a plan's first searches build them.
+    for q in 0..3 {
+        let mut grid = sensor_motion(&s, starts[q], types[q], HORIZON);
+        first.path_cover(q, starts[q], &[], &mut grid);
+    }
     let mut rng = StdRng::seed_from_u64(47);
     let mut multi = 0;
     for sensor in 0..3 {
@@ -459,6 +468,11 @@ fn path_gains_add_up_to_the_objective() {
                 .collect();
             let mut grid = sensor_motion(&s, start, ty, HORIZON);
             let cover = first.path_cover(sensor, start, &extra, &mut grid);
+            // The same over the others' paths named, read from their stops.
+            let others: Vec<usize> = (0..3).filter(|&q| with_others && q != sensor).collect();
+            let mut among = sensor_motion(&s, start, ty, HORIZON);
+            let cover_among = first.path_cover_among(sensor, start, &paths, &others, &mut among);
+            assert_eq!(grid, among);
             let background: f64 = first.by_step(&extra).iter().sum();
             for _ in 0..150 {
                 let mut at = start;
@@ -488,6 +502,7 @@ fn path_gains_add_up_to_the_objective() {
                     .collect();
                 let objective = first.by_step(&looks).iter().sum::<f64>() - background;
                 let gains = cover.value(&offsets);
+                assert_eq!(gains.to_bits(), cover_among.value(&offsets).to_bits());
                 assert!(
                     (gains - objective).abs() <= 1e-9 * objective.abs().max(1.0),
                     "sensor {sensor} on {cells:?}: gains {gains}, objective {objective}"

@@ -258,12 +258,7 @@ impl Fleet<'_> {
     ) -> FirstSearch {
         let first = self.first.expect("a fleet maximising first detections");
         let mut grid = self.motion(i);
-        let cover = first.path_cover(
-            i,
-            self.starts[i],
-            &self.all_looks(paths, sensors),
-            &mut grid,
-        );
+        let cover = first.path_cover_among(i, self.starts[i], paths, sensors, &mut grid);
         mark_too_close(&mut grid, self.starts[i], self.min_separation, avoid);
         let budget = if self.horizon <= 4 {
             FIRST_SEARCH_BUDGET

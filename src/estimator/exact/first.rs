@@ -266,9 +266,9 @@ impl<'e> FirstDetections<'e> {
         by_step
     }
 
-    /// The background of a search: the history, and over it `extra`'s
-    /// looks (`extra[t − 1]` taken at step `t`).
-    fn background(&self, extra: &[Vec<Look>]) -> Background {
+    /// The pieces of `extra`'s looks (`extra[t − 1]` taken at step `t`),
+    /// step by step.
+    fn pieces_of(&self, extra: &[Vec<Look>]) -> Vec<Piece> {
         let mut buf = Vec::new();
         let mut pieces = Vec::new();
         for (t, step) in extra.iter().enumerate() {
@@ -276,6 +276,36 @@ impl<'e> FirstDetections<'e> {
                 self.pieces(look, t + 1, &mut pieces, &mut buf);
             }
         }
+        pieces
+    }
+
+    /// The pieces of the looks of `sensors` on `paths` (`paths[q][t − 1]`
+    /// at step `t`), step by step in the order of `sensors`: the same as
+    /// [`FirstDetections::pieces_of`] their looks, read from each sensor's
+    /// stops where its search built them.
+    fn pieces_on(&self, paths: &[&[Cell]], sensors: &[usize], horizon: usize) -> Vec<Piece> {
+        let s = self.est.scenario;
+        let mut buf = Vec::new();
+        let mut pieces = Vec::new();
+        for t in 1..=horizon {
+            for &q in sensors {
+                let cell = paths[q][t - 1];
+                let cached = self.stops[q].get().and_then(|stops| {
+                    let offset = (cell.col - stops.start.col, cell.row - stops.start.row);
+                    stops.try_stop(t, offset).map(|r| &stops.pieces[r])
+                });
+                match cached {
+                    Some(own) => pieces.extend_from_slice(own),
+                    None => self.pieces(&s.look(self.est.types[q], cell), t, &mut pieces, &mut buf),
+                }
+            }
+        }
+        pieces
+    }
+
+    /// The background of a search: the history, and over it the `pieces`
+    /// of other looks, in the order their looks were taken.
+    fn background(&self, mut pieces: Vec<Piece>) -> Background {
         pieces.sort_by_key(|p| p.key);
         let mut keys = Vec::new();
         let mut merged = Profile::default();
@@ -314,6 +344,7 @@ impl<'e> FirstDetections<'e> {
             let extent = (grid.speed() * horizon) as i32;
             let side = grid.side();
             let mut stops = Stops {
+                start,
                 extent,
                 side,
                 slots: vec![u32::MAX; horizon * side * side],
@@ -364,7 +395,32 @@ impl<'e> FirstDetections<'e> {
         grid: &mut ValueGrid,
     ) -> PathCover<'_> {
         let stops = self.stops(sensor, start, grid);
-        let background = self.background(extra);
+        self.cover(stops, self.background(self.pieces_of(extra)), grid)
+    }
+
+    /// [`FirstDetections::path_cover`] against the looks of `sensors` on
+    /// `paths` (`paths[q][t − 1]` at step `t`, for every step of `grid`).
+    pub fn path_cover_among(
+        &self,
+        sensor: usize,
+        start: Cell,
+        paths: &[&[Cell]],
+        sensors: &[usize],
+        grid: &mut ValueGrid,
+    ) -> PathCover<'_> {
+        let stops = self.stops(sensor, start, grid);
+        let pieces = self.pieces_on(paths, sensors, grid.horizon());
+        self.cover(stops, self.background(pieces), grid)
+    }
+
+    /// The gains of `stops` over `background`; `grid`'s values become each
+    /// stop's gain alone.
+    fn cover<'s>(
+        &'s self,
+        stops: &'s Stops,
+        background: Background,
+        grid: &mut ValueGrid,
+    ) -> PathCover<'s> {
         // Which keys the extra looks touch: their ends move; the others'
         // are the history's.
         let mut overlay = vec![u32::MAX; self.history.start.len().saturating_sub(1)];
@@ -413,6 +469,8 @@ impl<'e> FirstDetections<'e> {
 /// its look there, and what the history detected up to their ends.
 #[derive(Debug)]
 struct Stops {
+    /// The sensor's start, which offsets are from.
+    start: Cell,
     extent: i32,
     side: usize,
     /// Per (step, offset) of the grid, its stop's index, `u32::MAX` where
@@ -436,6 +494,20 @@ impl Stops {
         (t - 1) * self.side * self.side
             + (dr + self.extent) as usize * self.side
             + (dc + self.extent) as usize
+    }
+
+    /// The pieces' indices of the stop of step `t` at offset `(dc, dr)`,
+    /// if the sensor may stand there then.
+    fn try_stop(&self, t: usize, (dc, dr): (i32, i32)) -> Option<std::ops::Range<usize>> {
+        if t == 0 || t * self.side * self.side > self.slots.len() {
+            return None;
+        }
+        if dc.abs() > self.extent || dr.abs() > self.extent {
+            return None;
+        }
+        let i = self.slots[self.index(t, (dc, dr))];
+        (i != u32::MAX)
+            .then(|| self.start_of[i as usize] as usize..self.start_of[i as usize + 1] as usize)
     }
 
     /// The pieces' indices of the stop of step `t` at offset `(dc, dr)`.
