@@ -297,6 +297,74 @@ fn stationary_counts_match_a_simulation() {
     assert!(blind.expected_targets_in_zone > 1.05 * ground.expected_targets_in_zone);
 }
 
+/// The yard's precomputed parts, on rays of `rays_per_pi`, and its
+/// sensors' types.
+struct Yard {
+    s: Scenario,
+    stats: Vec<Stats>,
+    rays: Vec<vigil::estimator::SourceRays>,
+    types: Vec<usize>,
+}
+
+impl Yard {
+    fn new(rays_per_pi: Option<f64>) -> Self {
+        use vigil::estimator::SourceRays;
+        let s = scenario(yard_spec());
+        let stats = (0..s.fovs.len())
+            .map(|slot| Stats::for_slot(&s, slot))
+            .collect();
+        let rays = match rays_per_pi {
+            Some(density) => SourceRays::with_density(&s, density),
+            None => SourceRays::for_scenario(&s),
+        };
+        let types = TYPES.iter().map(|n| s.type_index(n).unwrap()).collect();
+        Yard {
+            s,
+            stats,
+            rays,
+            types,
+        }
+    }
+
+    /// The sensors' looks `s` steps ago, for `s` in `0..=history`.
+    fn observed(&self, history: usize) -> Vec<Vec<Look>> {
+        (0..=history)
+            .map(|s_ago| {
+                track(s_ago)
+                    .iter()
+                    .zip(&self.types)
+                    .map(|(&c, &ty)| self.s.look(ty, c))
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// The exact estimator of the sensors at `track(0)` after `observed`.
+    fn estimator<'a>(
+        &'a self,
+        observed: &'a [Vec<Look>],
+        starts: &'a [Cell],
+        horizon: usize,
+    ) -> vigil::estimator::ExactEstimator<'a> {
+        use vigil::estimator::{ExactEstimator, Precomputed, Situation};
+        ExactEstimator::new(
+            Precomputed {
+                scenario: &self.s,
+                stats: &self.stats,
+                rays: &self.rays,
+                grid: None,
+            },
+            Situation {
+                observed,
+                targets: &[],
+                starts,
+                types: &self.types,
+                horizon,
+            },
+        )
+    }
+}
+
 /// The exact estimator's value of a look with only the looks of now
 /// behind it (and at some probes an excluded look), against a brute-force
 /// integral over a fine grid of points of its field of view: the density
@@ -305,35 +373,14 @@ fn stationary_counts_match_a_simulation() {
 /// target there and that the excluded look misses it now.
 #[test]
 fn values_match_a_brute_force_integral() {
-    use vigil::estimator::{Estimator, ExactEstimator, Precomputed, Situation, SourceRays};
+    use vigil::estimator::Estimator;
     use vigil::geometry::Point;
-    let s = scenario(yard_spec());
-    let stats: Vec<Stats> = (0..s.fovs.len())
-        .map(|slot| Stats::for_slot(&s, slot))
-        .collect();
-    let rays = SourceRays::with_density(&s, 2048.0);
-    let types: Vec<usize> = TYPES.iter().map(|n| s.type_index(n).unwrap()).collect();
-    let now: Vec<Look> = track(0)
-        .iter()
-        .zip(&types)
-        .map(|(&c, &ty)| s.look(ty, c))
-        .collect();
+    let yard = Yard::new(Some(2048.0));
+    let (s, types) = (&yard.s, &yard.types);
+    let observed = yard.observed(0);
+    let now = &observed[0];
     let starts = track(0).to_vec();
-    let est = ExactEstimator::new(
-        Precomputed {
-            scenario: &s,
-            stats: &stats,
-            rays: &rays,
-            grid: None,
-        },
-        Situation {
-            observed: std::slice::from_ref(&now),
-            targets: &[],
-            starts: &starts,
-            types: &types,
-            horizon: 2,
-        },
-    );
+    let est = yard.estimator(&observed, &starts, 2);
     // With an excluded look in half the probes: a camera east of the
     // building, whose view the building cuts, or the drone above it.
     let excluded = [s.look(types[0], cell(7, 8)), s.look(types[2], cell(9, 10))];
@@ -409,38 +456,12 @@ fn values_match_a_brute_force_integral() {
 #[test]
 fn path_gains_add_up_to_the_objective() {
     use vigil::coordination::sensor_motion;
-    use vigil::estimator::{ExactEstimator, FirstDetections, Precomputed, Situation, SourceRays};
-    let s = scenario(yard_spec());
-    let stats: Vec<Stats> = (0..s.fovs.len())
-        .map(|slot| Stats::for_slot(&s, slot))
-        .collect();
-    let rays = SourceRays::for_scenario(&s);
-    let types: Vec<usize> = TYPES.iter().map(|n| s.type_index(n).unwrap()).collect();
-    let observed: Vec<Vec<Look>> = (0..=HISTORY)
-        .map(|s_ago| {
-            track(s_ago)
-                .iter()
-                .zip(&types)
-                .map(|(&c, &ty)| s.look(ty, c))
-                .collect()
-        })
-        .collect();
+    use vigil::estimator::FirstDetections;
+    let yard = Yard::new(None);
+    let (s, types) = (&yard.s, &yard.types);
+    let observed = yard.observed(HISTORY);
     let starts = track(0).to_vec();
-    let est = ExactEstimator::new(
-        Precomputed {
-            scenario: &s,
-            stats: &stats,
-            rays: &rays,
-            grid: None,
-        },
-        Situation {
-            observed: &observed,
-            targets: &[],
-            starts: &starts,
-            types: &types,
-            horizon: HORIZON,
-        },
-    );
+    let est = yard.estimator(&observed, &starts, HORIZON);
     let first = FirstDetections::new(&est);
     let cells: Vec<Vec<Cell>> = (0..3)
         .map(|q| (1..=HORIZON).map(|t| path(t)[q]).collect())
@@ -448,7 +469,7 @@ fn path_gains_add_up_to_the_objective() {
     let paths: Vec<&[Cell]> = cells.iter().map(Vec::as_slice).collect();
     // Every sensor's stops built, as a plan's first searches build them.
     for q in 0..3 {
-        let mut grid = sensor_motion(&s, starts[q], types[q], HORIZON);
+        let mut grid = sensor_motion(s, starts[q], types[q], HORIZON);
         first.path_cover(q, starts[q], &[], &mut grid);
     }
     let mut rng = StdRng::seed_from_u64(47);
@@ -466,11 +487,11 @@ fn path_gains_add_up_to_the_objective() {
                         .collect()
                 })
                 .collect();
-            let mut grid = sensor_motion(&s, start, ty, HORIZON);
+            let mut grid = sensor_motion(s, start, ty, HORIZON);
             let cover = first.path_cover(sensor, start, &extra, &mut grid);
             // The same over the others' paths named, read from their stops.
             let others: Vec<usize> = (0..3).filter(|&q| with_others && q != sensor).collect();
-            let mut among = sensor_motion(&s, start, ty, HORIZON);
+            let mut among = sensor_motion(s, start, ty, HORIZON);
             let cover_among = first.path_cover_among(sensor, start, &paths, &others, &mut among);
             assert_eq!(grid, among);
             let background: f64 = first.by_step(&extra).iter().sum();
