@@ -59,7 +59,8 @@ pub struct Bounded {
     /// No legal path has more value than this, violation counts ignored
     /// (`best.value` when exhaustive on a grid without them).
     pub upper: f64,
-    /// Gains evaluated: the pairs', then the search's.
+    /// Gains evaluated: the lone-value path's, the pairs', then the
+    /// search's.
     pub evaluated: usize,
 }
 
