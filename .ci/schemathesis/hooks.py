@@ -78,6 +78,10 @@ UNSCHEMATISABLE = [
         "the paper estimator is refused for a scenario with obstacles, named by the path or body",
     ),
     (
+        r"^objective: first_detections needs the exact estimator",
+        "a relation between two fields (`objective: first_detections` with `estimator: paper`)",
+    ),
+    (
         r"^certify: joint coordination ",
         "a relation between two fields (`certify: false` with `coordination: joint`)",
     ),
