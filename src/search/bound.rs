@@ -100,13 +100,8 @@ pub fn best_path_bounded(grid: &ValueGrid, gain: &dyn PathGain, budget: usize) -
         .filter(|l| l.out[start] > f64::NEG_INFINITY)
         .map(|lone| {
             let cells = lone.best_path(grid);
-            let mut stops: Vec<Stop> = Vec::with_capacity(h);
-            let mut value = 0.0;
-            for (t, &o) in cells.iter().enumerate() {
-                value += gain.gain(t + 1, offset(o), &stops);
-                stops.push((t + 1, offset(o)));
-            }
             evaluated += h;
+            let value = score(gain, &offset, &|_, _| 0.0, &cells).value;
             (lone, cells, value)
         });
     // The pair gains: `pairs[first[(t−1)·n + o] + k]` for the k-th successor
@@ -248,6 +243,27 @@ pub fn best_path_bounded(grid: &ValueGrid, gain: &dyn PathGain, budget: usize) -
         upper,
         evaluated,
     }
+}
+
+/// The exact score of a whole path of grid indices (steps 1..=T), each
+/// stop's violations from `violations(t, o)` and offset from `offset(o)`.
+fn score(
+    gain: &dyn PathGain,
+    offset: &dyn Fn(usize) -> (i32, i32),
+    violations: &dyn Fn(usize, usize) -> f64,
+    cells: &[usize],
+) -> Lex {
+    let mut stops: Vec<Stop> = Vec::with_capacity(cells.len());
+    let mut total = ZERO;
+    for (t, &o) in cells.iter().enumerate() {
+        let at = offset(o);
+        total = total.add(Lex {
+            neg_violations: -violations(t + 1, o),
+            value: gain.gain(t + 1, at, &stops),
+        });
+        stops.push((t + 1, at));
+    }
+    total
 }
 
 /// The best sums of lone values (the grid's) into and out of each stop:
@@ -394,18 +410,8 @@ struct Search<'s> {
 impl Search<'_> {
     /// The exact score of a whole path of grid indices.
     fn score(&mut self, cells: &[usize]) -> Lex {
-        let mut stops: Vec<Stop> = Vec::with_capacity(cells.len());
-        let mut total = ZERO;
-        for (t, &o) in cells.iter().enumerate() {
-            let at = (self.offset)(o);
-            self.evaluated += 1;
-            total = total.add(Lex {
-                neg_violations: -(self.violations)(t + 1, o),
-                value: self.gain.gain(t + 1, at, &stops),
-            });
-            stops.push((t + 1, at));
-        }
-        total
+        self.evaluated += cells.len();
+        score(self.gain, self.offset, self.violations, cells)
     }
 
     /// Extends the prefix ending at `o` after step `t` (score `so_far`).

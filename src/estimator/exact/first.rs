@@ -448,12 +448,7 @@ impl<'e> FirstDetections<'e> {
         for t in 1..=grid.horizon() {
             grid.fill_step(t, |dc, dr| {
                 let i = stops.slots[stops.index(t, (dc, dr))];
-                (i != u32::MAX).then(|| {
-                    alone[stops.start_of[i as usize] as usize
-                        ..stops.start_of[i as usize + 1] as usize]
-                        .iter()
-                        .sum()
-                })
+                (i != u32::MAX).then(|| alone[stops.pieces_of(i as usize)].iter().sum())
             });
         }
         PathCover {
@@ -506,14 +501,17 @@ impl Stops {
             return None;
         }
         let i = self.slots[self.index(t, (dc, dr))];
-        (i != u32::MAX)
-            .then(|| self.start_of[i as usize] as usize..self.start_of[i as usize + 1] as usize)
+        (i != u32::MAX).then(|| self.pieces_of(i as usize))
+    }
+
+    /// The `i`-th stop's pieces' indices.
+    fn pieces_of(&self, i: usize) -> std::ops::Range<usize> {
+        self.start_of[i] as usize..self.start_of[i + 1] as usize
     }
 
     /// The pieces' indices of the stop of step `t` at offset `(dc, dr)`.
     fn stop(&self, t: usize, offset: (i32, i32)) -> std::ops::Range<usize> {
-        let i = self.slots[self.index(t, offset)] as usize;
-        self.start_of[i] as usize..self.start_of[i + 1] as usize
+        self.pieces_of(self.slots[self.index(t, offset)] as usize)
     }
 }
 
