@@ -378,6 +378,26 @@ impl Obstacles {
             .any(|o| o.kind == ObstacleKind::Building && o.polygon.contains_open(p))
     }
 
+    /// The speed of a target at `pos` moving `vel` per step, and how far
+    /// it flies from there before it enters a building (0 when it stands
+    /// in one, infinity when its path meets none): it still flies after
+    /// `t` steps while that distance exceeds `speed·t`.
+    pub fn flight(&self, pos: Point, vel: Point) -> (f64, f64) {
+        let speed = vel.x.hypot(vel.y);
+        if speed == 0.0 {
+            let stop = if self.inside_building(pos) {
+                0.0
+            } else {
+                f64::INFINITY
+            };
+            return (speed, stop);
+        }
+        (
+            speed,
+            self.stop(pos, Point::new(vel.x / speed, vel.y / speed)),
+        )
+    }
+
     /// Where a target flying from `o` along the unit direction `d` stops:
     /// the distance at which the ray first enters a building's interior
     /// (0 when it starts inside one), or infinity.

@@ -203,15 +203,45 @@ fn stationary_prefix(s: &Scenario, xs: &[f64], ys: &[f64]) -> Vec<f64> {
 
 impl ElementaryGrid {
     /// The grid of a scenario whose sensor types all have square fields of
-    /// view (the breakpoints of every size); `None` when one is a circle, or
-    /// when several sizes on a large lattice would make it larger than one
-    /// size can (then every value takes the general path), and with
-    /// obstacles, whose fields of view are not unions of rectangles once
-    /// sight lines are blocked.
+    /// view (the breakpoints of every size), with the closed-form
+    /// stationary mass; `None` when one is a circle, or when several sizes
+    /// on a large lattice would make it larger than one size can (then
+    /// every value takes the general path), and with obstacles, whose
+    /// buildings end flights where no closed form follows them (see
+    /// [`ElementaryGrid::with_mass`]).
     pub fn new(s: &Scenario) -> Option<Self> {
         if s.has_obstacles() {
             return None;
         }
+        let mut grid = Self::layout(s)?;
+        grid.prefix = stationary_prefix(s, &grid.xs, &grid.ys);
+        Some(grid)
+    }
+
+    /// The grid of a scenario as [`ElementaryGrid::new`] lays it out, with
+    /// the stationary mass of each rectangle that `mass` gives (row by
+    /// row, `b·nx + a`, from the laid-out grid): for scenarios whose mass
+    /// the rays measure (obstacles).
+    pub fn with_mass(s: &Scenario, mass: impl FnOnce(&Self) -> Vec<f64>) -> Option<Self> {
+        let mut grid = Self::layout(s)?;
+        let (nx, ny) = grid.dims();
+        let per_rect = mass(&grid);
+        assert_eq!(per_rect.len(), nx * ny, "one mass per rectangle");
+        let mut prefix = vec![0.0; (nx + 1) * (ny + 1)];
+        for b in 0..ny {
+            let mut row = 0.0;
+            for a in 0..nx {
+                row += per_rect[b * nx + a];
+                prefix[(b + 1) * (nx + 1) + a + 1] = prefix[b * (nx + 1) + a + 1] + row;
+            }
+        }
+        grid.prefix = prefix;
+        Some(grid)
+    }
+
+    /// The breakpoints, spans and lookup tables of the grid, without its
+    /// stationary mass (`prefix` empty).
+    fn layout(s: &Scenario) -> Option<Self> {
         let halves = s
             .fovs
             .iter()
@@ -249,7 +279,6 @@ impl ElementaryGrid {
             .iter()
             .map(|&h| span(&ys, s.rows, s.height, h))
             .collect();
-        let prefix = stationary_prefix(s, &xs, &ys);
         let (x_buckets, x_scale) = buckets(&xs);
         let (y_buckets, y_scale) = buckets(&ys);
         Some(ElementaryGrid {
@@ -257,7 +286,7 @@ impl ElementaryGrid {
             ys,
             col_span,
             row_span,
-            prefix,
+            prefix: Vec::new(),
             x_buckets,
             x_scale,
             y_buckets,

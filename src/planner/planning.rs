@@ -92,7 +92,11 @@ impl Planner {
             .collect::<Result<Vec<_>, _>>()?;
         cancel.check()?;
         let mut rays = SourceRays::with_density(&scenario, rays_per_pi);
-        let grid = ElementaryGrid::new(&scenario);
+        let grid = if scenario.has_obstacles() {
+            ElementaryGrid::with_mass(&scenario, |g| SourceRays::alive_mass(&rays, &scenario, g))
+        } else {
+            ElementaryGrid::new(&scenario)
+        };
         if let Some(grid) = &grid {
             SourceRays::index_crossings(&mut rays, &scenario, grid);
         }

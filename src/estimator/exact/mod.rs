@@ -88,6 +88,9 @@ pub struct ExactEstimator<'a> {
     rays: &'a [SourceRays],
     grid: Option<&'a ElementaryGrid>,
     known: Vec<Target>,
+    /// With obstacles, per known target, its speed and how far it flies
+    /// before a building ends its flight ([`crate::obstacle::Obstacles::flight`]).
+    flights: Vec<(f64, f64)>,
     /// The target classes, each on its source's rays.
     classes: Vec<ClassRays>,
     /// Per class (aligned with `classes`), where its rays crossed what was
@@ -209,16 +212,26 @@ impl<'a> ExactEstimator<'a> {
             .collect();
 
         let grid = grid.filter(|_| scenario.all_square());
+        let known: Vec<Target> = targets
+            .iter()
+            .copied()
+            .filter(|tg| scenario.in_zone(tg.pos))
+            .collect();
+        let flights = if scenario.has_obstacles() {
+            known
+                .iter()
+                .map(|tg| scenario.obstacles.flight(tg.pos, tg.vel))
+                .collect()
+        } else {
+            Vec::new()
+        };
         Self {
             scenario,
             stats,
             rays,
             grid,
-            known: targets
-                .iter()
-                .copied()
-                .filter(|tg| scenario.in_zone(tg.pos))
-                .collect(),
+            known,
+            flights,
             classes,
             seen,
             starts: starts.to_vec(),
@@ -424,6 +437,35 @@ impl<'a> ExactEstimator<'a> {
         }
     }
 
+    /// The block of elementary rectangles that every field of view
+    /// `sensor` may have at step `t` from `start` makes up.
+    fn reach_block(
+        &self,
+        grid: &ElementaryGrid,
+        sensor: usize,
+        start: Cell,
+        t: usize,
+    ) -> super::elementary::Block {
+        let s = self.scenario;
+        let ty = &s.types[self.types[sensor]];
+        let ti = (ty.speed * t) as i32;
+        let (lo, _, blo, _) = grid.span(
+            ty.fov_slot,
+            Cell {
+                col: (start.col - ti).max(0),
+                row: (start.row - ti).max(0),
+            },
+        );
+        let (_, hi, _, bhi) = grid.span(
+            ty.fov_slot,
+            Cell {
+                col: (start.col + ti).min(s.cols - 1),
+                row: (start.row + ti).min(s.rows - 1),
+            },
+        );
+        (lo, hi, blo, bhi)
+    }
+
     /// The sensor's window at step `t`, when it holds `k`'s block.
     fn block(&self, sensor: usize, k: Cell, t: usize) -> Option<&Window> {
         let (grid, win) = self.window_of(sensor, t)?;
@@ -496,22 +538,7 @@ impl Estimator for ExactEstimator<'_> {
         };
         let ty = &s.types[self.types[sensor]];
         // Prefix sums of the (masked) unseen mass over the sensor's reach.
-        let ti = (ty.speed * t) as i32;
-        let (lo, _, blo, _) = grid.span(
-            ty.fov_slot,
-            Cell {
-                col: (start.col - ti).max(0),
-                row: (start.row - ti).max(0),
-            },
-        );
-        let (_, hi, _, bhi) = grid.span(
-            ty.fov_slot,
-            Cell {
-                col: (start.col + ti).min(s.cols - 1),
-                row: (start.row + ti).min(s.rows - 1),
-            },
-        );
-        let sums = win.block_sums(grid, (lo, hi, blo, bhi), excluded);
+        let sums = win.block_sums(grid, self.reach_block(grid, sensor, start, t), excluded);
         // Known targets at step t, each with the chance that every excluded
         // look misses it: those no look holds are counted (an integer count
         // is the hot loop's cheapest form), the others summed by weight.
@@ -555,6 +582,11 @@ impl Estimator for ExactEstimator<'_> {
     }
 
     fn elements(&self, t: usize) -> Option<Elements<'_>> {
+        // A ground look sees part of its rectangles: no relaxation over
+        // them (the certificate takes the marginal bound).
+        if self.scenario.has_obstacles() {
+            return None;
+        }
         let grid = self.grid?;
         let step = self.windows.get(t.checked_sub(1)?)?;
         let (mut a0, mut a1, mut b0, mut b1) = (usize::MAX, 0, usize::MAX, 0);

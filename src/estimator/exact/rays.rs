@@ -374,8 +374,11 @@ impl SourceRays {
             // rule; the plain rule makes up for it on average (its
             // neighbours' rays run longer), the corrected one does not.
             // Rays too sparse for the grid (a coarse `rays_per_pi`, a
-            // narrow cone far out) keep the plain rule.
-            if crossed < (1.0 - MAX_UNCROSSED_MEASURE) * measure(&zone.rect) {
+            // narrow cone far out) keep the plain rule. So do scenarios
+            // with obstacles: their stationary mass is the rays' too
+            // ([`SourceRays::alive_mass`]), and the windows then give the
+            // per-cell path's values to rounding.
+            if s.has_obstacles() || crossed < (1.0 - MAX_UNCROSSED_MEASURE) * measure(&zone.rect) {
                 kappa.fill(1.0);
             }
             sr.crossings = Some(Crossings {
@@ -386,6 +389,57 @@ impl SourceRays {
                 kappa,
             });
         });
+    }
+
+    /// The stationary mass of each rectangle of `grid` (`b·nx + a`) by the
+    /// midpoint rule on these rays: each ray's length inside it, up to
+    /// where a building ends the flights along the ray, times the
+    /// source's targets per unit of length and angle (summed over its
+    /// classes) and the angular step. It is the mass that the per-cell
+    /// path of a scenario with obstacles integrates
+    /// (`sighted`), so windows built on it give the same values.
+    pub fn alive_mass(rays: &[SourceRays], s: &Scenario, grid: &ElementaryGrid) -> Vec<f64> {
+        let (nx, ny) = grid.dims();
+        let zone = s.zone_region();
+        let per_source: Vec<Vec<f64>> = rays
+            .par_iter()
+            .map(|sr| {
+                let density: f64 = s
+                    .classes_of(sr.source_index)
+                    .iter()
+                    .map(|class| class.rate / (sr.source.spread * class.speed))
+                    .sum::<f64>()
+                    * sr.step;
+                let mut mass = vec![0.0; nx * ny];
+                for (m, &(d, inv)) in sr.dirs.iter().enumerate() {
+                    let Some((r0, r1)) = zone.ray(sr.source.pos, d, inv) else {
+                        continue;
+                    };
+                    let r1 = r1.min(sr.stop(m));
+                    if r1 <= r0 {
+                        continue;
+                    }
+                    let segment = Segment {
+                        origin: sr.source.pos,
+                        dir: d,
+                        inv,
+                        from: r0,
+                        to: r1,
+                    };
+                    trace(grid, (0, nx, 0, ny), segment, |a, b, from, to| {
+                        mass[b * nx + a] += density * (to - from);
+                    });
+                }
+                mass
+            })
+            .collect();
+        let mut mass = vec![0.0; nx * ny];
+        for source in per_source {
+            for (total, m) in mass.iter_mut().zip(source) {
+                *total += m;
+            }
+        }
+        mass
     }
 
     /// Indexes where every ray crosses every cell's square field of view

@@ -14,12 +14,19 @@
 //! ([`RayHits::detected_upto`](super::seen::RayHits::detected_upto), a
 //! binary search), the second over the few pieces where excluded looks
 //! hold the ray. The same interval arithmetic and midpoint rule as without
-//! obstacles, evaluated per cell (the elementary grid's block sums assume
-//! fields of view that are unions of rectangles, which blocked sight lines
-//! break).
+//! obstacles, evaluated per cell.
+//!
+//! A look that sees its whole square (elevated, or a ground look no
+//! obstacle meets), against excluded looks that see theirs, takes the
+//! windows instead: its square is then a union of elementary rectangles,
+//! each holding its unseen mass (the grid's stationary mass is measured
+//! on the same rays, up to their stops, and the seen pieces are clipped
+//! there too), so its value is a block sum, the same to rounding. Blocked
+//! sight lines cut rectangles, so every other look stays per cell.
 
 use super::ExactEstimator;
-use crate::estimator::Target;
+use super::windows::BlockSums;
+use crate::estimator::elementary::ElementaryGrid;
 use crate::geometry::{Point, detection_pieces};
 use crate::limits::MAX_SPEED_CLASSES;
 use crate::obstacle::Sight;
@@ -28,6 +35,20 @@ use crate::search::ValueGrid;
 
 /// A look that excludes part of the targets, with what it cannot see.
 type Excluded<'a> = (&'a Look, Option<Sight>);
+
+/// The windows' prefix sums over a block, masked by the excluded looks
+/// that see their whole squares: the unseen mass of every field of view
+/// in the block that sees its whole square and meets no other excluded
+/// look.
+type Windowed<'a> = Option<(&'a ElementaryGrid, BlockSums)>;
+
+/// The excluded looks of `near` that see their whole squares.
+fn whole_squares(near: &[Excluded<'_>]) -> Vec<Look> {
+    near.iter()
+        .filter(|(_, v)| v.is_none())
+        .map(|(x, _)| **x)
+        .collect()
+}
 
 /// Scratch space of one value, kept across the cells of a fill.
 #[derive(Default)]
@@ -41,16 +62,12 @@ struct Scratch {
 }
 
 impl ExactEstimator<'_> {
-    /// True when the reported target `tg` still flies at step `t`: its
+    /// True when the `i`-th reported target still flies at step `t`: its
     /// straight path from now has not entered a building.
-    fn known_alive(&self, tg: &Target, t: usize) -> bool {
-        let obstacles = &self.scenario.obstacles;
-        let speed = tg.vel.x.hypot(tg.vel.y);
-        if speed == 0.0 {
-            return !obstacles.inside_building(tg.pos);
-        }
-        let d = Point::new(tg.vel.x / speed, tg.vel.y / speed);
-        obstacles.stop(tg.pos, d) > speed * t as f64
+    #[inline]
+    fn known_alive(&self, i: usize, t: usize) -> bool {
+        let (speed, stop) = self.flights[i];
+        stop > speed * t as f64
     }
 
     /// The looks of `excluded` that may meet `region`'s, each with what it
@@ -75,7 +92,12 @@ impl ExactEstimator<'_> {
         let fk = self.scenario.fov_region_of(self.types[sensor], k);
         let near = self.excluded_sights(excluded, &fk);
         let refs: Vec<&Excluded<'_>> = near.iter().collect();
-        self.sighted_at(sensor, k, t, &refs, &mut Scratch::default())
+        let windowed = self.block(sensor, k, t).and_then(|win| {
+            let grid = self.grid?;
+            let block = grid.span(self.scenario.types[self.types[sensor]].fov_slot, k);
+            Some((grid, win.block_sums(grid, block, &whole_squares(&near))))
+        });
+        self.sighted_at(sensor, k, t, &refs, &windowed, &mut Scratch::default())
     }
 
     /// [`Estimator::fill`](crate::estimator::Estimator::fill) with
@@ -96,6 +118,13 @@ impl ExactEstimator<'_> {
             disk: None,
         };
         let near = self.excluded_sights(excluded, &reach);
+        let windowed = self
+            .window_of(sensor, t)
+            .filter(|_| self.starts.get(sensor) == Some(&start))
+            .map(|(grid, win)| {
+                let block = self.reach_block(grid, sensor, start, t);
+                (grid, win.block_sums(grid, block, &whole_squares(&near)))
+            });
         let mut scratch = Scratch::default();
         let mut refs = Vec::with_capacity(near.len());
         out.fill_step(t, |dc, dr| {
@@ -109,18 +138,20 @@ impl ExactEstimator<'_> {
             let fk = s.fov_region_of(ty, k);
             refs.clear();
             refs.extend(near.iter().filter(|(x, _)| x.region.may_overlap(&fk)));
-            Some(self.sighted_at(sensor, k, t, &refs, &mut scratch))
+            Some(self.sighted_at(sensor, k, t, &refs, &windowed, &mut scratch))
         });
     }
 
     /// The value of `sensor` at `k` at step `t` against the excluded looks
-    /// `near` (those that may meet its field of view).
+    /// `near` (those that may meet its field of view), by the windows when
+    /// `windowed` holds `k`'s block and the looks see whole squares.
     fn sighted_at(
         &self,
         sensor: usize,
         k: Cell,
         t: usize,
         near: &[&Excluded<'_>],
+        windowed: &Windowed<'_>,
         scratch: &mut Scratch,
     ) -> f64 {
         let s = self.scenario;
@@ -132,8 +163,9 @@ impl ExactEstimator<'_> {
         let known: f64 = self
             .known
             .iter()
-            .map(|tg| (tg, tg.at(t)))
-            .filter(|&(tg, p)| fk.contains(p) && self.known_alive(tg, t) && sees(&sight, p))
+            .enumerate()
+            .map(|(i, tg)| (i, tg.at(t)))
+            .filter(|&(i, p)| fk.contains(p) && self.known_alive(i, t) && sees(&sight, p))
             .map(|(_, p)| p)
             .map(|p| {
                 near.iter()
@@ -142,7 +174,13 @@ impl ExactEstimator<'_> {
                     .product::<f64>()
             })
             .sum();
-        ty.p_detect * (known + self.unseen_sighted(&look, sight.as_ref(), t, near, scratch))
+        let unseen = match windowed {
+            Some((grid, sums)) if sight.is_none() && near.iter().all(|(_, v)| v.is_none()) => {
+                sums.sum(grid.span(ty.fov_slot, k))
+            }
+            _ => self.unseen_sighted(&look, sight.as_ref(), t, near, scratch),
+        };
+        ty.p_detect * (known + unseen)
     }
 
     /// `U` of `look` at step `t` (see the module docs).

@@ -299,7 +299,7 @@ impl SeenRays<'_> {
                     let lifts: Vec<f64> = (1..=steps).map(|t| class.speed * t as f64).collect();
                     let mut views: Vec<&mut [f64]> =
                         accs.iter_mut().map(Vec::as_mut_slice).collect();
-                    accumulate_whole(cr, sr.dirs.len(), class.weight, seen, &lifts, &mut views);
+                    accumulate_whole(sr, cr, class.weight, seen, &lifts, &mut views);
                 }
                 accs
             })
@@ -348,7 +348,7 @@ impl SeenRays<'_> {
         } = class;
         if let (true, Some(cr)) = (whole, &sr.crossings) {
             // The block is the grid: every ray, no bounds to check.
-            accumulate_whole(cr, sr.dirs.len(), w, seen, &[lift], &mut [acc]);
+            accumulate_whole(sr, cr, w, seen, &[lift], &mut [acc]);
             return;
         }
         let (a0, a1, b0, b1) = block;
@@ -383,8 +383,12 @@ impl SeenRays<'_> {
             let Some((wa, wb)) = region.ray(sr.source.pos, d, inv) else {
                 continue;
             };
-            // The seen union at step t, clipped to the block.
-            let (wa, wb) = (wa - lift, wb - lift);
+            // The seen union at step t, clipped to the block and to where
+            // a building ends the flights along the ray.
+            let (wa, wb) = (wa - lift, min(wb, sr.stop(m)) - lift);
+            if wb <= wa {
+                continue;
+            }
             let from = hits.partition_point(|&(_, q)| q <= wa);
             let Some(cr) = &sr.crossings else {
                 for (i, &(p, q)) in hits.iter().enumerate().skip(from) {
@@ -434,21 +438,22 @@ impl SeenRays<'_> {
     }
 }
 
-/// What the `rays` rays of one class saw in each rectangle of the whole
-/// grid, at each lift `lifts[i]` (`v·t`) into `accs[i]`, times the class's
-/// weight `w`. With several lifts (every step of a plan) the rays are read
-/// once, and the crossing of a ray's first interval is found from the
-/// previous lift's; each buffer gets the same sums in the same order as
-/// with one lift at a time.
+/// What the rays `sr` (crossing the grid as `cr` says) of one class saw in
+/// each rectangle of the whole grid, at each lift `lifts[i]` (`v·t`) into
+/// `accs[i]`, times the class's weight `w`; nothing past where a building
+/// ends a ray's flights. With several lifts (every step of a plan) the
+/// rays are read once, and the crossing of a ray's first interval is found
+/// from the previous lift's; each buffer gets the same sums in the same
+/// order as with one lift at a time.
 fn accumulate_whole(
+    sr: &SourceRays,
     cr: &Crossings,
-    rays: usize,
     w: f64,
     seen: &RayHits,
     lifts: &[f64],
     accs: &mut [&mut [f64]],
 ) {
-    for m in 0..rays {
+    for m in 0..sr.dirs.len() {
         let (rs, _, lin) = cr.of(m);
         let kappa = cr.area_correction(m);
         let hits = seen.of(m);
@@ -456,13 +461,15 @@ fn accumulate_whole(
             continue;
         }
         let detected = seen.detected(m);
+        let stop = sr.stop(m);
+        let exit = min(rs[lin.len()], stop);
         // Where the previous lift's first interval started.
         let mut hint = usize::MAX;
         for (&lift, acc) in lifts.iter().zip(accs.iter_mut()) {
             // The slice itself, so its start and length stay in registers
             // across the stores below.
             let acc: &mut [f64] = acc;
-            let end = rs[lin.len()] - lift;
+            let end = exit - lift;
             let from = hits.partition_point(|&(_, q)| q + lift <= rs[0]);
             let mut k = usize::MAX;
             for (i, &(p, q)) in hits.iter().enumerate().skip(from) {
@@ -474,7 +481,7 @@ fn accumulate_whole(
                 } else {
                     w * detected[i]
                 };
-                let (p, q) = (p + lift, q + lift);
+                let (p, q) = (p + lift, min(q + lift, stop));
                 k = if k == usize::MAX {
                     hint = first_crossing(rs, hint, p);
                     hint
