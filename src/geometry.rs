@@ -53,6 +53,16 @@ impl Rect {
         }
     }
 
+    /// The smallest rectangle holding both.
+    pub fn hull(&self, o: &Rect) -> Rect {
+        Rect {
+            x0: self.x0.min(o.x0),
+            y0: self.y0.min(o.y0),
+            x1: self.x1.max(o.x1),
+            y1: self.y1.max(o.y1),
+        }
+    }
+
     /// True when the closed rectangle has at least one point.
     pub fn is_empty(&self) -> bool {
         self.x0 > self.x1 || self.y0 > self.y1

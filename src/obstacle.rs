@@ -316,6 +316,57 @@ impl Shadow {
         }
     }
 
+    /// A rectangle holding the part of `rect` that this shadow hides, or
+    /// `None` when it hides none of it: the bounding box of `rect` clipped
+    /// by the shadow's half-planes, grown by a relative 1e-9 so that
+    /// rounding never leaves a hidden sliver out.
+    fn bbox_within(&self, rect: &Rect) -> Option<Rect> {
+        let Shadow::Planes(planes) = self else {
+            return Some(*rect);
+        };
+        let mut poly = vec![
+            Point::new(rect.x0, rect.y0),
+            Point::new(rect.x1, rect.y0),
+            Point::new(rect.x1, rect.y1),
+            Point::new(rect.x0, rect.y1),
+        ];
+        let mut next = Vec::with_capacity(poly.len() + planes.len());
+        for h in planes {
+            next.clear();
+            for (i, &p) in poly.iter().enumerate() {
+                let q = poly[(i + 1) % poly.len()];
+                let (sp, sq) = (h.slack(p), h.slack(q));
+                if sp >= 0.0 {
+                    next.push(p);
+                }
+                if (sp >= 0.0) != (sq >= 0.0) {
+                    let f = sp / (sp - sq);
+                    next.push(Point::new(p.x + (q.x - p.x) * f, p.y + (q.y - p.y) * f));
+                }
+            }
+            std::mem::swap(&mut poly, &mut next);
+            if poly.is_empty() {
+                return None;
+            }
+        }
+        let pad = 1e-9 * (1.0 + (rect.x1 - rect.x0).abs() + (rect.y1 - rect.y0).abs());
+        let bbox = poly.iter().fold(
+            Rect {
+                x0: f64::INFINITY,
+                y0: f64::INFINITY,
+                x1: f64::NEG_INFINITY,
+                y1: f64::NEG_INFINITY,
+            },
+            |b, p| Rect {
+                x0: b.x0.min(p.x - pad),
+                y0: b.y0.min(p.y - pad),
+                x1: b.x1.max(p.x + pad),
+                y1: b.y1.max(p.y + pad),
+            },
+        );
+        Some(bbox.intersect(rect))
+    }
+
     /// The open interval of `o + t·d` that is hidden.
     #[inline]
     fn on_line(&self, o: Point, d: Point) -> Option<(f64, f64)> {
@@ -475,6 +526,15 @@ impl Sight {
     #[inline]
     pub fn sees(&self, q: Point) -> bool {
         q == self.from || !self.shadows.iter().any(|s| s.hides(q))
+    }
+
+    /// A rectangle holding every point of `rect` that the viewpoint does
+    /// not see, or `None` when it sees all of it.
+    pub fn hidden_within(&self, rect: &Rect) -> Option<Rect> {
+        self.shadows
+            .iter()
+            .filter_map(|s| s.bbox_within(rect))
+            .reduce(|a, b| a.hull(&b))
     }
 
     /// Pushes onto `out` the visible parts of `[lo, hi]` on the line

@@ -118,6 +118,34 @@ proptest! {
         }
     }
 
+    /// Every point of a rectangle that a viewpoint does not see lies in
+    /// `hidden_within`'s rectangle (sampled on a 60 × 60 grid), which is
+    /// `None` only when every sample is seen.
+    #[test]
+    fn hidden_points_lie_in_the_hidden_box(
+        poly in polygons(),
+        p in point(),
+        (x0, y0, w, h) in (0.0..80.0f64, 0.0..80.0f64, 5.0..60.0f64, 5.0..60.0f64),
+    ) {
+        let rect = Rect { x0, y0, x1: x0 + w, y1: y0 + h };
+        let region = Region { rect, disk: None };
+        let Some(sight) = one(poly, ObstacleKind::Building).sight(p, &region) else {
+            return Ok(());
+        };
+        let hidden = sight.hidden_within(&rect);
+        for i in 0..60 {
+            for j in 0..60 {
+                let q = Point::new(
+                    x0 + w * (f64::from(i) + 0.5) / 60.0,
+                    y0 + h * (f64::from(j) + 0.5) / 60.0,
+                );
+                if !sight.sees(q) {
+                    prop_assert!(hidden.is_some_and(|b| b.contains(q)), "{:?} {:?}", q, hidden);
+                }
+            }
+        }
+    }
+
     /// A flight stops where sampling first finds the building's interior.
     #[test]
     fn stop_is_the_first_interior_point(poly in polygons(), o in point(), angle in 0.0..std::f64::consts::TAU) {

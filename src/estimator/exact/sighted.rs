@@ -17,16 +17,20 @@
 //! obstacles, evaluated per cell.
 //!
 //! A look that sees its whole square (elevated, or a ground look no
-//! obstacle meets), against excluded looks that see theirs, takes the
-//! windows instead: its square is then a union of elementary rectangles,
-//! each holding its unseen mass (the grid's stationary mass is measured
-//! on the same rays, up to their stops, and the seen pieces are clipped
-//! there too), so its value is a block sum, the same to rounding. Blocked
-//! sight lines cut rectangles, so every other look stays per cell.
+//! obstacle meets) takes the windows instead: its square is then a union
+//! of elementary rectangles, each holding its unseen mass (the grid's
+//! stationary mass is measured on the same rays, up to their stops, and
+//! the seen pieces are clipped there too), so its value is a block sum,
+//! the same to rounding. An excluded look that sees its whole square masks
+//! whole rectangles; one that an obstacle cuts is taken off each
+//! rectangle of a fill's reach once, by the rays, before the block sums
+//! (`less_what_cut_looks_detect`), since what it detects of a rectangle
+//! does not depend on the cell asking. Blocked sight lines cut a look's
+//! own rectangles, so a look an obstacle cuts stays per cell.
 
 use super::ExactEstimator;
-use super::windows::BlockSums;
-use crate::estimator::elementary::ElementaryGrid;
+use super::windows::{BlockSums, Window};
+use crate::estimator::elementary::{Block, ElementaryGrid, Segment, trace};
 use crate::geometry::{Point, detection_pieces};
 use crate::limits::MAX_SPEED_CLASSES;
 use crate::obstacle::Sight;
@@ -36,10 +40,9 @@ use crate::search::ValueGrid;
 /// A look that excludes part of the targets, with what it cannot see.
 type Excluded<'a> = (&'a Look, Option<Sight>);
 
-/// The windows' prefix sums over a block, masked by the excluded looks
-/// that see their whole squares: the unseen mass of every field of view
-/// in the block that sees its whole square and meets no other excluded
-/// look.
+/// The windows' prefix sums over a block, less what every excluded look
+/// detects: the unseen mass of every field of view in the block that sees
+/// its whole square.
 type Windowed<'a> = Option<(&'a ElementaryGrid, BlockSums)>;
 
 /// The excluded looks of `near` that see their whole squares.
@@ -70,6 +73,35 @@ impl ExactEstimator<'_> {
         stop > speed * t as f64
     }
 
+    /// The reported targets still flying at step `t` inside `region`, each
+    /// with the chance that every look of `near` that sees it misses it
+    /// (none that a certain look sees): what a cell of `region` counts of
+    /// each, if it sees it.
+    fn known_at(
+        &self,
+        t: usize,
+        region: &crate::geometry::Rect,
+        near: &[Excluded<'_>],
+    ) -> Vec<(Point, f64)> {
+        let sees = |sight: &Option<Sight>, p: Point| sight.as_ref().is_none_or(|v| v.sees(p));
+        self.known
+            .iter()
+            .enumerate()
+            .filter(|&(i, _)| self.known_alive(i, t))
+            .map(|(_, tg)| tg.at(t))
+            .filter(|&p| region.contains(p))
+            .map(|p| {
+                let miss = near
+                    .iter()
+                    .filter(|(x, v)| x.region.contains(p) && sees(v, p))
+                    .map(|(x, _)| x.miss())
+                    .product::<f64>();
+                (p, miss)
+            })
+            .filter(|&(_, miss)| miss > 0.0)
+            .collect()
+    }
+
     /// The looks of `excluded` that may meet `region`'s, each with what it
     /// cannot see.
     fn excluded_sights<'x>(
@@ -92,12 +124,25 @@ impl ExactEstimator<'_> {
         let fk = self.scenario.fov_region_of(self.types[sensor], k);
         let near = self.excluded_sights(excluded, &fk);
         let refs: Vec<&Excluded<'_>> = near.iter().collect();
-        let windowed = self.block(sensor, k, t).and_then(|win| {
-            let grid = self.grid?;
-            let block = grid.span(self.scenario.types[self.types[sensor]].fov_slot, k);
-            Some((grid, win.block_sums(grid, block, &whole_squares(&near))))
-        });
-        self.sighted_at(sensor, k, t, &refs, &windowed, &mut Scratch::default())
+        let known = self.known_at(t, &fk.rect, &near);
+        // An excluded look that an obstacle cuts: per cell (one value).
+        let windowed = self
+            .block(sensor, k, t)
+            .filter(|_| near.iter().all(|(_, v)| v.is_none()))
+            .and_then(|win| {
+                let grid = self.grid?;
+                let block = grid.span(self.scenario.types[self.types[sensor]].fov_slot, k);
+                Some((grid, win.block_sums(grid, block, &whole_squares(&near))))
+            });
+        self.sighted_at(
+            sensor,
+            k,
+            t,
+            &refs,
+            &known,
+            &windowed,
+            &mut Scratch::default(),
+        )
     }
 
     /// [`Estimator::fill`](crate::estimator::Estimator::fill) with
@@ -118,14 +163,22 @@ impl ExactEstimator<'_> {
             disk: None,
         };
         let near = self.excluded_sights(excluded, &reach);
+        let known = self.known_at(t, &reach.rect, &near);
+        let mut scratch = Scratch::default();
         let windowed = self
             .window_of(sensor, t)
             .filter(|_| self.starts.get(sensor) == Some(&start))
             .map(|(grid, win)| {
                 let block = self.reach_block(grid, sensor, start, t);
-                (grid, win.block_sums(grid, block, &whole_squares(&near)))
+                let cut: Vec<&Excluded<'_>> = near.iter().filter(|(_, v)| v.is_some()).collect();
+                let whole = whole_squares(&near);
+                if cut.is_empty() {
+                    return (grid, win.block_sums(grid, block, &whole));
+                }
+                let mut part = win.part(block);
+                self.less_what_cut_looks_detect(grid, &mut part, t, &cut, &mut scratch);
+                (grid, part.block_sums(grid, block, &whole))
             });
-        let mut scratch = Scratch::default();
         let mut refs = Vec::with_capacity(near.len());
         out.fill_step(t, |dc, dr| {
             let k = Cell {
@@ -138,19 +191,23 @@ impl ExactEstimator<'_> {
             let fk = s.fov_region_of(ty, k);
             refs.clear();
             refs.extend(near.iter().filter(|(x, _)| x.region.may_overlap(&fk)));
-            Some(self.sighted_at(sensor, k, t, &refs, &windowed, &mut scratch))
+            Some(self.sighted_at(sensor, k, t, &refs, &known, &windowed, &mut scratch))
         });
     }
 
     /// The value of `sensor` at `k` at step `t` against the excluded looks
-    /// `near` (those that may meet its field of view), by the windows when
-    /// `windowed` holds `k`'s block and the looks see whole squares.
+    /// `near` (those that may meet its field of view), with `known` the
+    /// reported targets that may lie in it ([`ExactEstimator::known_at`]),
+    /// by the windows when `windowed` holds `k`'s block and the looks see
+    /// whole squares.
+    #[allow(clippy::too_many_arguments)]
     fn sighted_at(
         &self,
         sensor: usize,
         k: Cell,
         t: usize,
         near: &[&Excluded<'_>],
+        known: &[(Point, f64)],
         windowed: &Windowed<'_>,
         scratch: &mut Scratch,
     ) -> f64 {
@@ -159,40 +216,49 @@ impl ExactEstimator<'_> {
         let look = s.look(self.types[sensor], k);
         let fk = look.region;
         let sight = s.sight(&look);
-        let sees = |sight: &Option<Sight>, p: Point| sight.as_ref().is_none_or(|v| v.sees(p));
-        let known: f64 = self
-            .known
+        let known: f64 = known
             .iter()
-            .enumerate()
-            .map(|(i, tg)| (i, tg.at(t)))
-            .filter(|&(i, p)| fk.contains(p) && self.known_alive(i, t) && sees(&sight, p))
-            .map(|(_, p)| p)
-            .map(|p| {
-                near.iter()
-                    .filter(|(x, v)| x.region.contains(p) && sees(v, p))
-                    .map(|(x, _)| x.miss())
-                    .product::<f64>()
-            })
+            .filter(|&&(p, _)| fk.contains(p) && sight.as_ref().is_none_or(|v| v.sees(p)))
+            .map(|&(_, miss)| miss)
             .sum();
         let unseen = match windowed {
-            Some((grid, sums)) if sight.is_none() && near.iter().all(|(_, v)| v.is_none()) => {
-                sums.sum(grid.span(ty.fov_slot, k))
+            // The whole square by the windows, less what the look does
+            // not see by the rays.
+            Some((grid, sums)) => {
+                let whole = sums.sum(grid.span(ty.fov_slot, k));
+                match sight
+                    .as_ref()
+                    .and_then(|v| Some((v, v.hidden_within(&fk.rect)?)))
+                {
+                    Some((v, hidden)) => {
+                        whole - self.unseen_sighted(&look, Some(v), Some(&hidden), t, near, scratch)
+                    }
+                    None => whole,
+                }
             }
-            _ => self.unseen_sighted(&look, sight.as_ref(), t, near, scratch),
+            None => self.unseen_sighted(&look, sight.as_ref(), None, t, near, scratch),
         };
         ty.p_detect * (known + unseen)
     }
 
-    /// `U` of `look` at step `t` (see the module docs).
+    /// `U` of `look` at step `t` (see the module docs); with `hidden` (a
+    /// rectangle holding every point of the look's field of view that its
+    /// sight misses), the same integral over the part it does not see
+    /// instead, on the rays that cross `hidden` only.
     fn unseen_sighted(
         &self,
         look: &Look,
         sight: Option<&Sight>,
+        hidden: Option<&crate::geometry::Rect>,
         t: usize,
         excluded: &[&Excluded<'_>],
         scratch: &mut Scratch,
     ) -> f64 {
         let fk = &look.region;
+        let crossed = match hidden {
+            Some(&rect) => crate::geometry::Region { rect, disk: None },
+            None => *fk,
+        };
         let Scratch {
             buf,
             parts,
@@ -215,7 +281,7 @@ impl ExactEstimator<'_> {
             first = last;
             let sr = &self.rays[ri];
             let o = sr.source.pos;
-            let Some((a, b)) = sr.range(fk, buf) else {
+            let Some((a, b)) = sr.range(&crossed, buf) else {
                 continue;
             };
             // A source has at most MAX_SPEED_CLASSES classes.
@@ -233,6 +299,22 @@ impl ExactEstimator<'_> {
                 match sight {
                     Some(v) => v.visible(o, d, lo, hi, parts),
                     None => parts.push((lo, hi)),
+                }
+                if hidden.is_some() {
+                    // The gaps between the visible parts, in place.
+                    let n = parts.len();
+                    let mut from = lo;
+                    for i in 0..n {
+                        let (p, q) = parts[i];
+                        if p > from {
+                            parts.push((from, p));
+                        }
+                        from = q;
+                    }
+                    if hi > from {
+                        parts.push((from, hi));
+                    }
+                    parts.drain(..n);
                 }
                 if parts.is_empty() {
                     continue;
@@ -285,5 +367,118 @@ impl ExactEstimator<'_> {
             }
         }
         unseen
+    }
+
+    /// Takes off each rectangle of `win` (a window over a block) what the
+    /// excluded looks `cut`, each of which an obstacle cuts, detect there
+    /// at step `t` of the unseen targets: `∫ ρ (1 − d)(1 − Π (1 − p))`
+    /// over the parts of the rays they see, the product over the cut looks
+    /// that see a point. The excluded looks that see whole squares mask
+    /// whole rectangles afterwards ([`Window::block_sums`]), which makes
+    /// the product over all of them.
+    fn less_what_cut_looks_detect(
+        &self,
+        grid: &ElementaryGrid,
+        win: &mut Window,
+        t: usize,
+        cut: &[&Excluded<'_>],
+        scratch: &mut Scratch,
+    ) {
+        let block: Block = (win.a0, win.a0 + win.na, win.b0, win.b0 + win.nb);
+        let rect = crate::geometry::Rect {
+            x0: grid.xs[block.0],
+            x1: grid.xs[block.1],
+            y0: grid.ys[block.2],
+            y1: grid.ys[block.3],
+        };
+        // The rays that may meet a cut look inside the block.
+        let mut bbox = cut[0].0.region.rect;
+        for (x, _) in cut {
+            bbox = bbox.hull(&x.region.rect);
+        }
+        let region = crate::geometry::Region {
+            rect: bbox.intersect(&rect),
+            disk: None,
+        };
+        if region.rect.is_empty() {
+            return;
+        }
+        let within = crate::geometry::Region { rect, disk: None };
+        let Scratch {
+            buf,
+            cut: visible,
+            pieces,
+            segments,
+            events,
+            ..
+        } = scratch;
+        let (a0, b0, na) = (win.a0, win.b0, win.na);
+        let unseen = win.unseen_mut();
+        let mut first = 0;
+        while first < self.classes.len() {
+            let ri = self.classes[first].rays;
+            let last = first
+                + self.classes[first..]
+                    .iter()
+                    .take_while(|c| c.rays == ri)
+                    .count();
+            let classes = first..last;
+            first = last;
+            let sr = &self.rays[ri];
+            let o = sr.source.pos;
+            let Some((ma, mb)) = sr.range(&region, buf) else {
+                continue;
+            };
+            for m in ma..mb {
+                let (d, inv) = sr.dirs[m];
+                let Some((lo, hi)) = within.ray(o, d, inv) else {
+                    continue;
+                };
+                let hi = hi.min(sr.stop(m));
+                if hi <= lo {
+                    continue;
+                }
+                pieces.clear();
+                for (x, v) in cut {
+                    let Some((p, q)) = x.region.ray(o, d, inv) else {
+                        continue;
+                    };
+                    let (p, q) = (p.max(lo), q.min(hi));
+                    if q <= p {
+                        continue;
+                    }
+                    if let Some(v) = v {
+                        visible.clear();
+                        v.visible(o, d, p, q, visible);
+                        pieces.extend(visible.iter().map(|&(p, q)| (p, q, x.p_detect)));
+                    }
+                }
+                if pieces.is_empty() {
+                    continue;
+                }
+                segments.clear();
+                detection_pieces(pieces, lo, hi, events, |u, v, q| segments.push((u, v, q)));
+                for &(u, v, q) in segments.iter() {
+                    let segment = Segment {
+                        origin: o,
+                        dir: d,
+                        inv,
+                        from: u,
+                        to: v,
+                    };
+                    trace(grid, block, segment, |a, b, from, to| {
+                        let mut detected = 0.0;
+                        for c in classes.clone() {
+                            let (class, hits) = (&self.classes[c], &self.seen[c]);
+                            let lift = class.speed * t as f64;
+                            let seen = hits.detected_upto(m, to - lift)
+                                - hits.detected_upto(m, from - lift);
+                            detected += class.weight * ((to - from) - seen);
+                        }
+                        unseen[(b - b0) * na + (a - a0)] -= q * detected;
+                    });
+                }
+            }
+        }
     }
 }

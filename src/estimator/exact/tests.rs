@@ -271,9 +271,9 @@ fn the_sweep_cuts_the_pieces_detection_pieces_cuts() {
 /// `site-campus`, drones and robots (some by buildings and screens, some
 /// in the open) after 16 steps of history, reported targets (some
 /// walking into buildings), fills and single values at every step,
-/// against no excluded look, a drone's, a robot's that a building cuts
-/// and one in the open; with the rays' crossings indexed and without
-/// (the grid walk).
+/// against no excluded look, a drone's, a robot's that a building cuts,
+/// one in the open and another cut one that overlaps the first; with the
+/// rays' crossings indexed and without (the grid walk).
 #[test]
 fn windows_give_the_per_cell_values_with_obstacles() {
     use crate::estimator::Target;
@@ -363,7 +363,10 @@ fn windows_give_the_per_cell_values_with_obstacles() {
         s.look(drone, Cell { col: 12, row: 18 }),
         s.look(robot, Cell { col: 13, row: 15 }),
         s.look(robot, Cell { col: 31, row: 3 }),
+        s.look(robot, Cell { col: 15, row: 13 }),
     ];
+    assert!(free(robot, Cell { col: 15, row: 13 }));
+    assert!(s.sight(&excluded_looks[3]).is_some());
     assert!(s.sight(&excluded_looks[1]).is_some());
     assert!(s.sight(&excluded_looks[2]).is_none());
     let (mut windowed, mut compared) = (0, 0);

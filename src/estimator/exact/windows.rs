@@ -127,6 +127,28 @@ impl Window {
         &self.unseen[b * self.na..(b + 1) * self.na]
     }
 
+    /// The window over `block` (global indices, inside this one), a copy.
+    pub(super) fn part(&self, (a0, a1, b0, b1): Block) -> Window {
+        let (na, nb) = (a1 - a0, b1 - b0);
+        let mut unseen = Vec::with_capacity(na * nb);
+        for b in b0..b1 {
+            let row = (b - self.b0) * self.na + (a0 - self.a0);
+            unseen.extend_from_slice(&self.unseen[row..row + na]);
+        }
+        Window {
+            a0,
+            b0,
+            na,
+            nb,
+            unseen,
+        }
+    }
+
+    /// The unseen mass of each rectangle, row by row, to take from.
+    pub(super) fn unseen_mut(&mut self) -> &mut [f64] {
+        &mut self.unseen
+    }
+
     /// Prefix sums of the unseen mass over `block` (global indices, inside
     /// the window), each rectangle times the probability that every
     /// excluded look misses it (fields of view are unions of rectangles:
