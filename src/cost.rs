@@ -30,8 +30,9 @@
 //!
 //! With obstacles the statistics cast rays instead of the closed forms,
 //! and [`precompute_ms`] adds them ([`obstacle_rays`], with two
-//! coefficients of their own). A plan with obstacles takes the general
-//! path, whose terms below count it.
+//! coefficients of their own). A plan with obstacles takes the windows
+//! for every look that sees its whole square, and the rays for what a
+//! ground look near an obstacle does not see (`sighted` below).
 //!
 //! Plan ([`plan_ms`]); `n` sensors, horizon `T`; per sensor and step `t`
 //! its reachable cells `(2vt+1)²` clipped to the lattice and their block of
@@ -59,10 +60,14 @@
 //! | general: cells × classes | 3.943e-4 | circles: a ray range per cell and class |
 //! | general: cells × rays × (1 + ov) | 1.351e-5 | its rays, with the overlapping looks |
 //! | general: cells × targets | 1.287e-6 | every reported target per cell |
+//! | sighted: cells × rays near obstacles | 2.000e-5 | a ground look's hidden part by its rays: cells × rays × the share of its reach whose squares meet an obstacle |
 //! | paper: setup | 1.410e-5 | per sensor: `(2vT+1)²` overlaps, targets, 512 escape samples per source and class |
 //! | paper: cells × (seen + E) | 7.086e-7 | per cell: the sensor's targets and the excluded looks |
 //! | paper: cells × ov² | 9.092e-6 | the excluded area's cover |
 //! | paper iterated: cells × n × (1 + ov) | 7.370e-6 | every lower-ranked sensor's change |
+//!
+//! The `sighted` coefficient is fitted alone, the others held, on
+//! `site-campus`'s fleets (`--only campus`; `docs/obstacles.md`).
 
 use crate::coordination::{Coordination, Objective};
 use crate::estimator::{
@@ -89,7 +94,7 @@ pub const PRECOMPUTE_MODEL: [(&str, f64); 7] = [
 
 /// The plan model: each term's name and coefficient, milliseconds per unit,
 /// in the order of [`plan_terms`].
-pub const PLAN_MODEL: [(&str, f64); 18] = [
+pub const PLAN_MODEL: [(&str, f64); 19] = [
     ("1", 2.038e-2),
     ("seen: look-rays, certain", 4.110e-6),
     ("seen: look-rays, uncertain", 9.124e-5),
@@ -104,6 +109,7 @@ pub const PLAN_MODEL: [(&str, f64); 18] = [
     ("general: cells × classes", 3.943e-4),
     ("general: cells × rays × (1 + ov)", 1.351e-5),
     ("general: cells × targets", 1.287e-6),
+    ("sighted: cells × rays near obstacles", 2.0e-5),
     ("paper: setup", 1.410e-5),
     ("paper: cells × (seen + E)", 7.086e-7),
     ("paper: cells × ov²", 9.092e-6),
@@ -175,19 +181,21 @@ pub struct PlanTerms {
     pub general_rays: f64,
     /// general: cells × targets (`PLAN_MODEL[13]`).
     pub general_targets: f64,
-    /// paper: setup (`PLAN_MODEL[14]`).
+    /// sighted: cells × rays near obstacles (`PLAN_MODEL[14]`).
+    pub sighted_rays: f64,
+    /// paper: setup (`PLAN_MODEL[15]`).
     pub paper_setup: f64,
-    /// paper: cells × (seen + E) (`PLAN_MODEL[15]`).
+    /// paper: cells × (seen + E) (`PLAN_MODEL[16]`).
     pub paper_cells: f64,
-    /// paper: cells × ov² (`PLAN_MODEL[16]`).
+    /// paper: cells × ov² (`PLAN_MODEL[17]`).
     pub paper_overlaps: f64,
-    /// paper iterated: cells × n × (1 + ov) (`PLAN_MODEL[17]`).
+    /// paper iterated: cells × n × (1 + ov) (`PLAN_MODEL[18]`).
     pub paper_iterated: f64,
 }
 
 impl PlanTerms {
     /// The terms in the order of [`PLAN_MODEL`].
-    pub fn to_array(&self) -> [f64; 18] {
+    pub fn to_array(&self) -> [f64; 19] {
         [
             self.constant,
             self.seen_certain,
@@ -203,6 +211,7 @@ impl PlanTerms {
             self.general_classes,
             self.general_rays,
             self.general_targets,
+            self.sighted_rays,
             self.paper_setup,
             self.paper_cells,
             self.paper_overlaps,
@@ -358,6 +367,36 @@ pub fn precompute_terms(s: &Scenario) -> PrecomputeTerms {
         }
     }
     t
+}
+
+/// The share of the cells from `lo` to `hi` (a block) whose square field
+/// of view of half width `h` meets an obstacle's bounding box, from the
+/// boxes grown by `h` (overlaps counted twice, at most 1). O(obstacles).
+fn obstructed_share(s: &Scenario, lo: Cell, hi: Cell, h: f64) -> f64 {
+    let cs = s.cell_size;
+    let reach = crate::geometry::Rect {
+        x0: f64::from(lo.col) * cs,
+        y0: f64::from(lo.row) * cs,
+        x1: f64::from(hi.col + 1) * cs,
+        y1: f64::from(hi.row + 1) * cs,
+    };
+    let covered: f64 = s
+        .obstacles
+        .list()
+        .iter()
+        .map(|ob| {
+            let b = ob.polygon.bbox();
+            crate::geometry::Rect {
+                x0: b.x0 - h,
+                y0: b.y0 - h,
+                x1: b.x1 + h,
+                y1: b.y1 + h,
+            }
+            .intersect(&reach)
+            .area()
+        })
+        .sum();
+    (covered / reach.area()).min(1.0)
 }
 
 /// The share of the angles towards the zone that a source's cone holds
@@ -590,6 +629,11 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> PlanTerms {
             });
             total[step] += rects;
             blocks[step] += rects / own;
+            let near_obstacles = if grid.is_some() && !ty.elevated {
+                obstructed_share(s, lo, hi, half(ty.fov))
+            } else {
+                0.0
+            };
             for (&(w, share), &miss) in passes.iter().zip(&miss) {
                 let ex = e * share;
                 t.fill_cells += w * cells;
@@ -600,6 +644,7 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> PlanTerms {
                     let checks = if a > 0.0 { (1.0 - miss) / a } else { ex };
                     t.fill_targets += w * (known + in_zone[step] * checks);
                     t.fill_clear_targets += w * cells * in_zone[step] * miss;
+                    t.sighted_rays += w * cells * per_look * near_obstacles;
                 } else if exact {
                     t.general_classes += w * cells * classes;
                     t.general_rays += w * cells * per_look * (1.0 + ov * share);

@@ -348,6 +348,15 @@ fn plan_cases(b: &mut Builder) {
             .remove(0);
         b.plan(W, format!("fleet {f} ({spec})"), fleet, r);
     }
+    let campus = b.planner(builtins().remove(4));
+    for spec in ["drone:4,robot:6", "robot:10", "drone:10"] {
+        let types =
+            vigil_sim::driver::fleet_types(&b.planners[campus].scenario, Some(spec), 10).unwrap();
+        let r = reference()
+            .requests_of_fleet(&b.planners[campus], 1, types)
+            .remove(0);
+        b.plan(W, format!("campus {spec}"), campus, r);
+    }
 
     // Spread: combinations, larger lattices, circles.
     let mix = |n: usize, t: usize, h: usize| Workload {
