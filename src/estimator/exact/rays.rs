@@ -401,42 +401,34 @@ impl SourceRays {
     pub fn alive_mass(rays: &[SourceRays], s: &Scenario, grid: &ElementaryGrid) -> Vec<f64> {
         let (nx, ny) = grid.dims();
         let zone = s.zone_region();
-        let per_source: Vec<Vec<f64>> = rays
-            .par_iter()
-            .map(|sr| {
-                let density: f64 = s
-                    .classes_of(sr.source_index)
-                    .iter()
-                    .map(|class| class.rate / (sr.source.spread * class.speed))
-                    .sum::<f64>()
-                    * sr.step;
-                let mut mass = vec![0.0; nx * ny];
-                for (m, &(d, inv)) in sr.dirs.iter().enumerate() {
-                    let Some((r0, r1)) = zone.ray(sr.source.pos, d, inv) else {
-                        continue;
-                    };
-                    let r1 = r1.min(sr.stop(m));
-                    if r1 <= r0 {
-                        continue;
-                    }
-                    let segment = Segment {
-                        origin: sr.source.pos,
-                        dir: d,
-                        inv,
-                        from: r0,
-                        to: r1,
-                    };
-                    trace(grid, (0, nx, 0, ny), segment, |a, b, from, to| {
-                        mass[b * nx + a] += density * (to - from);
-                    });
-                }
-                mass
-            })
-            .collect();
+        // One buffer, the sources in order: a grid may have millions of
+        // rectangles, too many for a buffer per source.
         let mut mass = vec![0.0; nx * ny];
-        for source in per_source {
-            for (total, m) in mass.iter_mut().zip(source) {
-                *total += m;
+        for sr in rays {
+            let density: f64 = s
+                .classes_of(sr.source_index)
+                .iter()
+                .map(|class| class.rate / (sr.source.spread * class.speed))
+                .sum::<f64>()
+                * sr.step;
+            for (m, &(d, inv)) in sr.dirs.iter().enumerate() {
+                let Some((r0, r1)) = zone.ray(sr.source.pos, d, inv) else {
+                    continue;
+                };
+                let r1 = r1.min(sr.stop(m));
+                if r1 <= r0 {
+                    continue;
+                }
+                let segment = Segment {
+                    origin: sr.source.pos,
+                    dir: d,
+                    inv,
+                    from: r0,
+                    to: r1,
+                };
+                trace(grid, (0, nx, 0, ny), segment, |a, b, from, to| {
+                    mass[b * nx + a] += density * (to - from);
+                });
             }
         }
         mass
