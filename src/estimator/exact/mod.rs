@@ -5,6 +5,7 @@
 //! (seen sets along rays), [`windows`] (per-step unseen mass over the
 //! elementary grid) and, here, the per-cell values.
 
+mod cell_sights;
 mod first;
 mod rays;
 mod seen;
@@ -91,6 +92,9 @@ pub struct ExactEstimator<'a> {
     /// With obstacles, per known target, its speed and how far it flies
     /// before a building ends its flight ([`crate::obstacle::Obstacles::flight`]).
     flights: Vec<(f64, f64)>,
+    /// With obstacles, per ground sensor, what its looks cannot see over
+    /// its reach (empty for an elevated one).
+    sights: Vec<cell_sights::SightCache>,
     /// The target classes, each on its source's rays.
     classes: Vec<ClassRays>,
     /// Per class (aligned with `classes`), where its rays crossed what was
@@ -225,6 +229,23 @@ impl<'a> ExactEstimator<'a> {
         } else {
             Vec::new()
         };
+        let sights = if scenario.has_obstacles() {
+            starts
+                .iter()
+                .zip(types)
+                .map(|(&start, &ty)| {
+                    let ty = &scenario.types[ty];
+                    let extent = if ty.elevated {
+                        -1
+                    } else {
+                        (ty.speed * horizon) as i32
+                    };
+                    cell_sights::SightCache::new(start, extent)
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         Self {
             scenario,
             stats,
@@ -232,6 +253,7 @@ impl<'a> ExactEstimator<'a> {
             grid,
             known,
             flights,
+            sights,
             classes,
             seen,
             starts: starts.to_vec(),

@@ -29,6 +29,7 @@
 //! own rectangles, so a look an obstacle cuts stays per cell.
 
 use super::ExactEstimator;
+use super::cell_sights::CellSight;
 use super::windows::{BlockSums, Window};
 use crate::estimator::elementary::{Block, ElementaryGrid, Segment, trace};
 use crate::geometry::{Point, detection_pieces};
@@ -215,30 +216,62 @@ impl ExactEstimator<'_> {
         let ty = &s.types[self.types[sensor]];
         let look = s.look(self.types[sensor], k);
         let fk = look.region;
-        let sight = s.sight(&look);
-        let known: f64 = known
-            .iter()
-            .filter(|&&(p, _)| fk.contains(p) && sight.as_ref().is_none_or(|v| v.sees(p)))
-            .map(|&(_, miss)| miss)
-            .sum();
-        let unseen = match windowed {
-            // The whole square by the windows, less what the look does
-            // not see by the rays.
-            Some((grid, sums)) => {
-                let whole = sums.sum(grid.span(ty.fov_slot, k));
-                match sight
-                    .as_ref()
-                    .and_then(|v| Some((v, v.hidden_within(&fk.rect)?)))
-                {
-                    Some((v, hidden)) => {
-                        whole - self.unseen_sighted(&look, Some(v), Some(&hidden), t, near, scratch)
+        self.with_cell_sight(sensor, k, &look, |sight, hidden| {
+            let known: f64 = known
+                .iter()
+                .filter(|&&(p, _)| fk.contains(p) && sight.is_none_or(|v| v.sees(p)))
+                .map(|&(_, miss)| miss)
+                .sum();
+            let unseen = match (windowed, sight) {
+                // The whole square by the windows, less what the look does
+                // not see by the rays.
+                (Some((grid, sums)), _) => {
+                    let whole = sums.sum(grid.span(ty.fov_slot, k));
+                    match (sight, hidden) {
+                        (Some(v), Some(hidden)) => {
+                            whole
+                                - self.unseen_sighted(
+                                    &look,
+                                    Some(v),
+                                    Some(hidden),
+                                    t,
+                                    near,
+                                    scratch,
+                                )
+                        }
+                        _ => whole,
                     }
-                    None => whole,
                 }
-            }
-            None => self.unseen_sighted(&look, sight.as_ref(), None, t, near, scratch),
+                (None, sight) => self.unseen_sighted(&look, sight, None, t, near, scratch),
+            };
+            ty.p_detect * (known + unseen)
+        })
+    }
+
+    /// Calls `f` with what `sensor`'s `look` at `k` cannot see and a box
+    /// holding the part of its field of view that it misses (`None` for
+    /// both when it sees all of it), from the sensor's cache when `k` is in
+    /// its reach.
+    fn with_cell_sight<R>(
+        &self,
+        sensor: usize,
+        k: Cell,
+        look: &Look,
+        f: impl FnOnce(Option<&Sight>, Option<&crate::geometry::Rect>) -> R,
+    ) -> R {
+        let compute = || -> CellSight {
+            let sight = self.scenario.sight(look)?;
+            let hidden = sight.hidden_within(&look.region.rect);
+            Some((sight, hidden))
         };
-        ty.p_detect * (known + unseen)
+        let call = |cs: &CellSight| match cs {
+            Some((v, hidden)) => f(Some(v), hidden.as_ref()),
+            None => f(None, None),
+        };
+        match self.sights.get(sensor).and_then(|c| c.slot(k)) {
+            Some(slot) => call(slot.get_or_init(compute)),
+            None => call(&compute()),
+        }
     }
 
     /// `U` of `look` at step `t` (see the module docs); with `hidden` (a
