@@ -276,37 +276,119 @@ fn the_sweep_cuts_the_pieces_detection_pieces_cuts() {
 /// rays' crossings indexed and without (the grid walk).
 #[test]
 fn windows_give_the_per_cell_values_with_obstacles() {
-    use crate::estimator::Target;
-    use crate::geometry::Point;
-    use crate::search::ValueGrid;
     let s = builtins()
         .into_iter()
         .find(|s| s.id == "site-campus")
         .expect("built in");
-    let stats: Vec<Stats> = (0..s.fovs.len())
-        .map(|slot| Stats::for_slot(&s, slot))
-        .collect();
-    let mut rays = SourceRays::for_scenario(&s);
-    let grid =
-        ElementaryGrid::with_mass(&s, |g| SourceRays::alive_mass(&rays, &s, g)).expect("squares");
-    let walked = rays.clone();
-    SourceRays::index_crossings(&mut rays, &s, &grid);
-    assert!(rays.iter().all(|sr| sr.crossings.is_some()));
     let (drone, robot) = (
         s.type_index("drone").expect("drone"),
         s.type_index("robot").expect("robot"),
     );
-    let free = |ty: usize, c: Cell| s.on_lattice(c) && s.is_free(ty, c);
+    let cell = |col, row| Cell { col, row };
     let candidates = [
-        (drone, Cell { col: 9, row: 20 }),
-        (robot, Cell { col: 14, row: 14 }),
-        (drone, Cell { col: 30, row: 8 }),
-        (robot, Cell { col: 25, row: 14 }),
-        (robot, Cell { col: 30, row: 1 }),
-        (drone, Cell { col: 20, row: 25 }),
+        (drone, cell(9, 20)),
+        (robot, cell(14, 14)),
+        (drone, cell(30, 8)),
+        (robot, cell(25, 14)),
+        (robot, cell(30, 1)),
+        (drone, cell(20, 25)),
     ];
+    let excluded_looks = [
+        s.look(drone, cell(12, 18)),
+        s.look(robot, cell(13, 15)),
+        s.look(robot, cell(31, 3)),
+        s.look(robot, cell(15, 13)),
+    ];
+    assert!(s.is_free(robot, cell(15, 13)));
+    assert!(s.sight(&excluded_looks[3]).is_some());
+    assert!(s.sight(&excluded_looks[1]).is_some());
+    assert!(s.sight(&excluded_looks[2]).is_none());
+    let (compared, windowed) = windows_against_per_cell(&s, &candidates, &excluded_looks);
+    assert!(compared > 10_000, "{compared}");
+    assert!(windowed > 50, "{windowed}");
+}
+
+/// The same on a yard whose two square sizes put the elementary grid's
+/// breakpoints off the cells' edges: ground cameras (p 0.8, 70 m) and
+/// elevated drones (p 0.6, 60 m, two cells a step), two gates with cones
+/// and speed mixtures, a building in the middle, one across the east
+/// fence and a hedge.
+#[test]
+fn windows_give_the_per_cell_values_on_a_yard() {
+    let spec: crate::scenario::ScenarioSpec = serde_json::from_value(serde_json::json!({
+        "zone": {"width": 200.0, "height": 200.0},
+        "cell_size": 10.0,
+        "fov": {"shape": "square", "half_width": 35.0},
+        "p_detect": 0.8,
+        "sensor_types": {
+            "drone": {"fov": {"shape": "square", "half_width": 30.0}, "speed": 2,
+                      "p_detect": 0.6, "elevated": true}
+        },
+        "sources": [
+            {"x": -1.0, "y": 100.0, "rate": 0.6, "direction": 0.0, "spread": 90.0,
+             "speeds": [{"speed": 6.0, "weight": 2.0}, {"speed": 14.0, "weight": 1.0}]},
+            {"x": 100.0, "y": -1.0, "rate": 0.5, "direction": 90.0, "spread": 120.0,
+             "speeds": [{"speed": 8.0, "weight": 1.0}]}
+        ],
+        "obstacles": [
+            {"polygon": [[80.0, 80.0], [125.0, 80.0], [125.0, 120.0], [80.0, 120.0]]},
+            {"polygon": [[170.0, 140.0], [215.0, 150.0], [185.0, 185.0]], "kind": "building"},
+            {"polygon": [[30.0, 30.0], [60.0, 40.0], [45.0, 60.0]], "kind": "screen"}
+        ]
+    }))
+    .expect("a spec");
+    let s = Scenario::new(spec).expect("valid");
+    let (drone, camera) = (
+        s.type_index("drone").expect("drone"),
+        s.type_index("default").expect("default"),
+    );
+    let cell = |col, row| Cell { col, row };
+    let candidates = [
+        (camera, cell(6, 11)),
+        (drone, cell(10, 10)),
+        (camera, cell(14, 6)),
+        (camera, cell(4, 4)),
+        (drone, cell(3, 15)),
+        (camera, cell(15, 15)),
+    ];
+    let excluded_looks = [
+        s.look(camera, cell(7, 8)),
+        s.look(drone, cell(9, 12)),
+        s.look(camera, cell(13, 9)),
+    ];
+    assert!(s.sight(&excluded_looks[0]).is_some());
+    let (compared, windowed) = windows_against_per_cell(&s, &candidates, &excluded_looks);
+    assert!(compared > 5_000, "{compared}");
+    assert!(windowed > 20, "{windowed}");
+}
+
+/// Fills and single values of the sensors of `candidates` (those free to
+/// stand there; at least five) with the windows against the per-cell
+/// path: every step of a 3-step plan after 16 steps of history, reported
+/// targets, against each prefix of `excluded_looks`, with the rays'
+/// crossings indexed and walked. Returns the values compared and the
+/// probes whose look and excluded looks all see whole squares.
+fn windows_against_per_cell(
+    s: &Scenario,
+    candidates: &[(usize, Cell)],
+    excluded_looks: &[Look],
+) -> (usize, usize) {
+    use crate::estimator::Target;
+    use crate::geometry::Point;
+    use crate::search::ValueGrid;
+    let stats: Vec<Stats> = (0..s.fovs.len())
+        .map(|slot| Stats::for_slot(s, slot))
+        .collect();
+    let mut rays = SourceRays::for_scenario(s);
+    let grid =
+        ElementaryGrid::with_mass(s, |g| SourceRays::alive_mass(&rays, s, g)).expect("squares");
+    let walked = rays.clone();
+    SourceRays::index_crossings(&mut rays, s, &grid);
+    assert!(rays.iter().all(|sr| sr.crossings.is_some()));
+    let free = |ty: usize, c: Cell| s.on_lattice(c) && s.is_free(ty, c);
     let (types, starts): (Vec<usize>, Vec<Cell>) = candidates
-        .into_iter()
+        .iter()
+        .copied()
         .filter(|&(ty, c)| free(ty, c))
         .unzip();
     assert!(starts.len() >= 5, "{starts:?}");
@@ -342,7 +424,7 @@ fn windows_give_the_per_cell_values_with_obstacles() {
         let grid = with_grid.then_some(&grid);
         let est = ExactEstimator::new(
             Precomputed {
-                scenario: &s,
+                scenario: s,
                 stats: &stats,
                 rays,
                 grid,
@@ -359,16 +441,6 @@ fn windows_give_the_per_cell_values_with_obstacles() {
         est
     };
     let per_cell = build(false, false);
-    let excluded_looks = [
-        s.look(drone, Cell { col: 12, row: 18 }),
-        s.look(robot, Cell { col: 13, row: 15 }),
-        s.look(robot, Cell { col: 31, row: 3 }),
-        s.look(robot, Cell { col: 15, row: 13 }),
-    ];
-    assert!(free(robot, Cell { col: 15, row: 13 }));
-    assert!(s.sight(&excluded_looks[3]).is_some());
-    assert!(s.sight(&excluded_looks[1]).is_some());
-    assert!(s.sight(&excluded_looks[2]).is_none());
     let (mut windowed, mut compared) = (0, 0);
     for (label, walk) in [("indexed", false), ("walked", true)] {
         let est = build(walk, true);
@@ -430,6 +502,5 @@ fn windows_give_the_per_cell_values_with_obstacles() {
             }
         }
     }
-    assert!(compared > 10_000, "{compared}");
-    assert!(windowed > 50, "{windowed}");
+    (compared, windowed)
 }
