@@ -499,14 +499,22 @@ impl ExactEstimator<'_> {
                         from: u,
                         to: v,
                     };
+                    // The seen mass up to the start of each rectangle's
+                    // part, per class: the trace's parts follow on from
+                    // each other, so each end is searched for once.
+                    let mut upto = [0.0; MAX_SPEED_CLASSES];
+                    for (slot, c) in classes.clone().enumerate() {
+                        let lift = self.classes[c].speed * t as f64;
+                        upto[slot] = self.seen[c].detected_upto(m, u - lift);
+                    }
                     trace(grid, block, segment, |a, b, from, to| {
                         let mut detected = 0.0;
-                        for c in classes.clone() {
+                        for (slot, c) in classes.clone().enumerate() {
                             let (class, hits) = (&self.classes[c], &self.seen[c]);
                             let lift = class.speed * t as f64;
-                            let seen = hits.detected_upto(m, to - lift)
-                                - hits.detected_upto(m, from - lift);
-                            detected += class.weight * ((to - from) - seen);
+                            let end = hits.detected_upto(m, to - lift);
+                            detected += class.weight * ((to - from) - (end - upto[slot]));
+                            upto[slot] = end;
                         }
                         unseen[(b - b0) * na + (a - a0)] -= q * detected;
                     });
