@@ -528,6 +528,12 @@ impl Sight {
         q == self.from || !self.shadows.iter().any(|s| s.hides(q))
     }
 
+    /// True when the viewpoint is inside an obstacle: it sees nothing but
+    /// itself.
+    pub fn blind(&self) -> bool {
+        self.shadows.iter().any(|s| matches!(s, Shadow::Everything))
+    }
+
     /// A rectangle holding every point of `rect` that the viewpoint does
     /// not see, or `None` when it sees all of it.
     pub fn hidden_within(&self, rect: &Rect) -> Option<Rect> {

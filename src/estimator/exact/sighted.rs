@@ -228,6 +228,9 @@ impl ExactEstimator<'_> {
                 (Some((grid, sums)), _) => {
                     let whole = sums.sum(grid.span(ty.fov_slot, k));
                     match (sight, hidden) {
+                        // From inside a screen: nothing, exactly (not the
+                        // square less itself, which rounds).
+                        (Some(v), _) if v.blind() => 0.0,
                         (Some(v), Some(hidden)) => {
                             whole
                                 - self.unseen_sighted(

@@ -312,7 +312,7 @@ fn windows_give_the_per_cell_values_with_obstacles() {
 /// breakpoints off the cells' edges: ground cameras (p 0.8, 70 m) and
 /// elevated drones (p 0.6, 60 m, two cells a step), two gates with cones
 /// and speed mixtures, a building in the middle, one across the east
-/// fence and a hedge.
+/// fence and a hedge, with a camera standing in it.
 #[test]
 fn windows_give_the_per_cell_values_on_a_yard() {
     let spec: crate::scenario::ScenarioSpec = serde_json::from_value(serde_json::json!({
@@ -357,6 +357,11 @@ fn windows_give_the_per_cell_values_on_a_yard() {
         s.look(camera, cell(13, 9)),
     ];
     assert!(s.sight(&excluded_looks[0]).is_some());
+    // The camera at (4, 4) stands in the hedge.
+    assert!(
+        s.sight(&s.look(camera, cell(4, 4)))
+            .is_some_and(|v| v.blind())
+    );
     let (compared, windowed) = windows_against_per_cell(&s, &candidates, &excluded_looks);
     assert!(compared > 5_000, "{compared}");
     assert!(windowed > 20, "{windowed}");
@@ -490,6 +495,10 @@ fn windows_against_per_cell(
                             "{label} value sensor {i} {k:?} t={t} excluded {x}: {va} against {vb}"
                         );
                         let look = s.look(ty, k);
+                        // A look from inside a screen sees nothing, exactly.
+                        if s.sight(&look).is_some_and(|v| v.blind()) {
+                            assert_eq!(va, 0.0, "{label} {k:?} t={t}");
+                        }
                         if s.sight(&look).is_none()
                             && excluded.iter().all(|x| {
                                 !x.region.may_overlap(&look.region) || s.sight(x).is_none()
