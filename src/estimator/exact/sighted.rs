@@ -54,6 +54,36 @@ fn whole_squares(near: &[Excluded<'_>]) -> Vec<Look> {
         .collect()
 }
 
+/// Pushes onto `pieces`, cleared first, the parts of `[lo, hi]` on the
+/// ray `o + r·d` (`inv` its inverse) that each look of `looks` sees, with
+/// its detection probability: what an excluded look takes off the ray.
+fn seen_by(
+    looks: &[&Excluded<'_>],
+    (o, d, inv): (Point, Point, Point),
+    (lo, hi): (f64, f64),
+    visible: &mut Vec<(f64, f64)>,
+    pieces: &mut Vec<(f64, f64, f64)>,
+) {
+    pieces.clear();
+    for (x, v) in looks {
+        let Some((p, q)) = x.region.ray(o, d, inv) else {
+            continue;
+        };
+        let (p, q) = (p.max(lo), q.min(hi));
+        if q <= p {
+            continue;
+        }
+        match v {
+            Some(v) => {
+                visible.clear();
+                v.visible(o, d, p, q, visible);
+                pieces.extend(visible.iter().map(|&(p, q)| (p, q, x.p_detect)));
+            }
+            None => pieces.push((p, q, x.p_detect)),
+        }
+    }
+}
+
 /// Scratch space of one value, kept across the cells of a fill.
 #[derive(Default)]
 struct Scratch {
@@ -101,6 +131,23 @@ impl ExactEstimator<'_> {
             })
             .filter(|&(_, miss)| miss > 0.0)
             .collect()
+    }
+
+    /// Each source's rays (an index into `rays`) and its classes (a range
+    /// of `classes`, which are consecutive and share the rays).
+    fn sources(&self) -> impl Iterator<Item = (usize, std::ops::Range<usize>)> + '_ {
+        let mut first = 0;
+        std::iter::from_fn(move || {
+            let ri = self.classes.get(first)?.rays;
+            let last = first
+                + self.classes[first..]
+                    .iter()
+                    .take_while(|c| c.rays == ri)
+                    .count();
+            let classes = first..last;
+            first = last;
+            Some((ri, classes))
+        })
     }
 
     /// The looks of `excluded` that may meet `region`'s, each with what it
@@ -304,17 +351,7 @@ impl ExactEstimator<'_> {
             events,
         } = scratch;
         let mut unseen = 0.0;
-        // The classes of a source are consecutive and share its rays.
-        let mut first = 0;
-        while first < self.classes.len() {
-            let ri = self.classes[first].rays;
-            let last = first
-                + self.classes[first..]
-                    .iter()
-                    .take_while(|c| c.rays == ri)
-                    .count();
-            let classes = first..last;
-            first = last;
+        for (ri, classes) in self.sources() {
             let sr = &self.rays[ri];
             let o = sr.source.pos;
             let Some((a, b)) = sr.range(&crossed, buf) else {
@@ -357,24 +394,7 @@ impl ExactEstimator<'_> {
                 }
                 // Where the excluded looks hold this ray, cut into pieces
                 // of one detection probability each.
-                pieces.clear();
-                for (x, v) in excluded {
-                    let Some((p, q)) = x.region.ray(o, d, inv) else {
-                        continue;
-                    };
-                    let (p, q) = (p.max(lo), q.min(hi));
-                    if q <= p {
-                        continue;
-                    }
-                    match v {
-                        Some(v) => {
-                            cut.clear();
-                            v.visible(o, d, p, q, cut);
-                            pieces.extend(cut.iter().map(|&(p, q)| (p, q, x.p_detect)));
-                        }
-                        None => pieces.push((p, q, x.p_detect)),
-                    }
-                }
+                seen_by(excluded, (o, d, inv), (lo, hi), cut, pieces);
                 segments.clear();
                 if !pieces.is_empty() {
                     detection_pieces(pieces, lo, hi, events, |u, v, q| segments.push((u, v, q)));
@@ -450,16 +470,7 @@ impl ExactEstimator<'_> {
         } = scratch;
         let (a0, b0, na) = (win.a0, win.b0, win.na);
         let unseen = win.unseen_mut();
-        let mut first = 0;
-        while first < self.classes.len() {
-            let ri = self.classes[first].rays;
-            let last = first
-                + self.classes[first..]
-                    .iter()
-                    .take_while(|c| c.rays == ri)
-                    .count();
-            let classes = first..last;
-            first = last;
+        for (ri, classes) in self.sources() {
             let sr = &self.rays[ri];
             let o = sr.source.pos;
             let Some((ma, mb)) = sr.range(&region, buf) else {
@@ -474,21 +485,7 @@ impl ExactEstimator<'_> {
                 if hi <= lo {
                     continue;
                 }
-                pieces.clear();
-                for (x, v) in cut {
-                    let Some((p, q)) = x.region.ray(o, d, inv) else {
-                        continue;
-                    };
-                    let (p, q) = (p.max(lo), q.min(hi));
-                    if q <= p {
-                        continue;
-                    }
-                    if let Some(v) = v {
-                        visible.clear();
-                        v.visible(o, d, p, q, visible);
-                        pieces.extend(visible.iter().map(|&(p, q)| (p, q, x.p_detect)));
-                    }
-                }
+                seen_by(cut, (o, d, inv), (lo, hi), visible, pieces);
                 if pieces.is_empty() {
                     continue;
                 }
