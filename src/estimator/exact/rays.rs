@@ -221,6 +221,16 @@ impl SourceRays {
         self.stops.get(m).copied().unwrap_or(f64::INFINITY)
     }
 
+    /// The part `[lo, hi]` of ray `m` inside `region` and before where a
+    /// building ends its flights, if it has length.
+    #[inline]
+    pub(super) fn alive_in(&self, m: usize, region: &Region) -> Option<(f64, f64)> {
+        let (d, inv) = self.dirs[m];
+        let (lo, hi) = region.ray(self.source.pos, d, inv)?;
+        let hi = hi.min(self.stop(m));
+        (hi > lo).then_some((lo, hi))
+    }
+
     /// The grids of every source of a scenario with a non-zero rate, at
     /// its rays per π ([`Scenario::rays_per_pi`]).
     pub fn for_scenario(s: &Scenario) -> Vec<SourceRays> {
@@ -412,13 +422,9 @@ impl SourceRays {
                 .sum::<f64>()
                 * sr.step;
             for (m, &(d, inv)) in sr.dirs.iter().enumerate() {
-                let Some((r0, r1)) = zone.ray(sr.source.pos, d, inv) else {
+                let Some((r0, r1)) = sr.alive_in(m, &zone) else {
                     continue;
                 };
-                let r1 = r1.min(sr.stop(m));
-                if r1 <= r0 {
-                    continue;
-                }
                 let segment = Segment {
                     origin: sr.source.pos,
                     dir: d,

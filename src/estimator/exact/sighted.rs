@@ -361,13 +361,9 @@ impl ExactEstimator<'_> {
             let mut sums = [0.0; MAX_SPEED_CLASSES];
             for m in a..b {
                 let (d, inv) = sr.dirs[m];
-                let Some((lo, hi)) = fk.ray(o, d, inv) else {
+                let Some((lo, hi)) = sr.alive_in(m, fk) else {
                     continue;
                 };
-                let hi = hi.min(sr.stop(m));
-                if hi <= lo {
-                    continue;
-                }
                 parts.clear();
                 match sight {
                     Some(v) => v.visible(o, d, lo, hi, parts),
@@ -478,13 +474,9 @@ impl ExactEstimator<'_> {
             };
             for m in ma..mb {
                 let (d, inv) = sr.dirs[m];
-                let Some((lo, hi)) = within.ray(o, d, inv) else {
+                let Some((lo, hi)) = sr.alive_in(m, &within) else {
                     continue;
                 };
-                let hi = hi.min(sr.stop(m));
-                if hi <= lo {
-                    continue;
-                }
                 seen_by(cut, (o, d, inv), (lo, hi), visible, pieces);
                 if pieces.is_empty() {
                     continue;

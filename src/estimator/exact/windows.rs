@@ -402,15 +402,12 @@ impl SeenRays<'_> {
                 }
             };
             let (d, inv) = sr.dirs[m];
-            let Some((wa, wb)) = region.ray(sr.source.pos, d, inv) else {
-                continue;
-            };
             // The seen union at step t, clipped to the block and to where
             // a building ends the flights along the ray.
-            let (wa, wb) = (wa - lift, min(wb, sr.stop(m)) - lift);
-            if wb <= wa {
+            let Some((wa, wb)) = sr.alive_in(m, &region) else {
                 continue;
-            }
+            };
+            let (wa, wb) = (wa - lift, wb - lift);
             let from = hits.partition_point(|&(_, q)| q <= wa);
             let Some(cr) = &sr.crossings else {
                 for (i, &(p, q)) in hits.iter().enumerate().skip(from) {
