@@ -97,6 +97,50 @@ pub(crate) fn check_certify(
     Ok(certify)
 }
 
+/// The cell and type of a sensor at `(x, y)` of type `name` (`default` when
+/// `None`): in the zone, of a known type, on a cell its type may stand on.
+/// `field` names it in errors; it is formatted only on error, since a
+/// history holds thousands of positions.
+pub(crate) fn place(
+    s: &Scenario,
+    field: &dyn Fn() -> String,
+    x: f64,
+    y: f64,
+    name: Option<&str>,
+) -> Result<(Cell, usize), ValidationError> {
+    let name = name.unwrap_or(DEFAULT_TYPE);
+    let ty = s.type_index(name).ok_or_else(|| {
+        let known: Vec<&str> = s.types.iter().map(|t| t.name.as_str()).collect();
+        ValidationError::new(
+            format!("{}.type", field()),
+            format!(
+                "unknown sensor type {name:?}; the scenario has {}",
+                known.join(", ")
+            ),
+        )
+    })?;
+    finite(|| format!("{}.x", field()), x)?;
+    finite(|| format!("{}.y", field()), y)?;
+    let p = Point::new(x, y);
+    if !s.in_zone(p) {
+        return Err(ValidationError::new(
+            field(),
+            format!(
+                "({x}, {y}) is outside the zone [0,{}]×[0,{}]",
+                s.width, s.height
+            ),
+        ));
+    }
+    let c = s.snap(p);
+    match s.blocked_for(ty, c) {
+        Some(why) => Err(ValidationError::new(
+            field(),
+            format!("cell (col {}, row {}) {why}", c.col, c.row),
+        )),
+        None => Ok((c, ty)),
+    }
+}
+
 impl PlanInput {
     /// The sensors' cells now, in request order.
     pub fn starts(&self) -> &[Cell] {
@@ -140,44 +184,6 @@ impl PlanInput {
                 format!("at most {MAX_HISTORY_STEPS} steps, got {}", history.len()),
             ));
         }
-        // Field names are formatted only on error: a history holds thousands
-        // of positions.
-        let in_zone =
-            |field: &dyn Fn() -> String, x: f64, y: f64| -> Result<Cell, ValidationError> {
-                finite(|| format!("{}.x", field()), x)?;
-                finite(|| format!("{}.y", field()), y)?;
-                let p = Point::new(x, y);
-                if !s.in_zone(p) {
-                    return Err(ValidationError::new(
-                        field(),
-                        format!(
-                            "({x}, {y}) is outside the zone [0,{}]×[0,{}]",
-                            s.width, s.height
-                        ),
-                    ));
-                }
-                Ok(s.snap(p))
-            };
-        let type_of = |field: &dyn Fn() -> String, name: Option<&str>| {
-            let name = name.unwrap_or(DEFAULT_TYPE);
-            s.type_index(name).ok_or_else(|| {
-                let known: Vec<&str> = s.types.iter().map(|t| t.name.as_str()).collect();
-                ValidationError::new(
-                    format!("{}.type", field()),
-                    format!(
-                        "unknown sensor type {name:?}; the scenario has {}",
-                        known.join(", ")
-                    ),
-                )
-            })
-        };
-        let free = |field: &dyn Fn() -> String, c: Cell, ty: usize| match s.blocked_for(ty, c) {
-            Some(why) => Err(ValidationError::new(
-                field(),
-                format!("cell (col {}, row {}) {why}", c.col, c.row),
-            )),
-            None => Ok(c),
-        };
         let mut seen = HashSet::new();
         let mut ids = Vec::with_capacity(req.sensors.len());
         let mut starts = Vec::with_capacity(req.sensors.len());
@@ -190,9 +196,9 @@ impl PlanInput {
                 ));
             }
             let field = || format!("sensors[{i}]");
-            let ty = type_of(&field, sensor.sensor_type.as_deref())?;
+            let (cell, ty) = place(s, &field, sensor.x, sensor.y, sensor.sensor_type.as_deref())?;
             types.push(ty);
-            starts.push(free(&field, in_zone(&field, sensor.x, sensor.y)?, ty)?);
+            starts.push(cell);
             ids.push(sensor.id.clone());
         }
         let mut targets = Vec::with_capacity(req.targets.len());
@@ -221,8 +227,7 @@ impl PlanInput {
                     .enumerate()
                     .map(|(pi, p)| {
                         let field = || format!("history[{si}][{pi}]");
-                        let ty = type_of(&field, p.sensor_type.as_deref())?;
-                        Ok((free(&field, in_zone(&field, p.x, p.y)?, ty)?, ty))
+                        place(s, &field, p.x, p.y, p.sensor_type.as_deref())
                     })
                     .collect::<Result<Vec<_>, ValidationError>>()?,
             );
