@@ -28,6 +28,7 @@ pub mod coordination;
 pub mod cost;
 pub mod estimator;
 pub mod evaluate;
+pub mod fit;
 pub mod geometry;
 pub mod http;
 pub mod limits;

@@ -87,3 +87,29 @@ pub const MAX_BUDGET_MS: u64 = 1000;
 /// with the most targets allowed ([`MAX_TARGETS`]) written at full
 /// precision.
 pub const MAX_BODY_BYTES: usize = 4 * 1024 * 1024;
+
+// Fitting source rates (`POST /v1/scenarios/{id}/fit`, sessions that learn).
+
+/// Most steps in one fit window.
+pub const MAX_FIT_STEPS: usize = 500;
+/// Most detections in one step of a fit window.
+pub const MAX_FIT_DETECTIONS: usize = 20_000;
+/// Largest fit request body accepted, bytes: a window of [`MAX_FIT_STEPS`]
+/// steps with 64 sensors and 64 detections a step, written at full
+/// precision, fits with room to spare.
+pub const MAX_FIT_BODY_BYTES: usize = 32 * 1024 * 1024;
+/// Rays per π over which a fit integrates each source's exposure (the
+/// midpoint rule over takeoff angles): a fit is not on the planning loop's
+/// clock, so it takes the finest grid a spec may ask for.
+pub const FIT_RAYS_PER_PI: usize = MAX_RAYS_PER_PI;
+/// Shape of the Gamma prior that `"prior": "scenario"` puts on each
+/// source's rate, centred on the spec's rate: worth one target's detection.
+pub const RATE_PRIOR_SHAPE: f64 = 1.0;
+/// Default traceback and look tolerances, as a fraction of the zone's
+/// larger side: wide enough for exact data written at full precision.
+pub const DEFAULT_FIT_DISTANCE_TOLERANCE: f64 = 1e-6;
+/// Default speed tolerance of a traceback, relative to a class's speed.
+pub const DEFAULT_FIT_SPEED_TOLERANCE: f64 = 1e-6;
+/// Most distinct tracks a learning session remembers (each counts once
+/// for the session's life); past it the oldest are forgotten.
+pub const MAX_SESSION_TRACKS: usize = 1_000_000;

@@ -289,6 +289,7 @@ impl Scenario {
                 source: i,
                 speed,
                 rate: v.source.rate * weight,
+                share: weight,
             }));
             class_offsets.push(classes.len());
             if !obstacles.is_empty() {

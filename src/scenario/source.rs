@@ -177,6 +177,9 @@ pub struct TargetClass {
     /// Targets of the class emitted per step: the source's rate times the
     /// class's normalised weight.
     pub rate: f64,
+    /// The class's normalised weight: its share of its source's targets
+    /// (kept apart from `rate`, which is 0 for a silent source).
+    pub share: f64,
 }
 
 impl TargetClass {

@@ -1,0 +1,220 @@
+//! Exposure: how many of a source's targets a window of looks detects at
+//! least once, per unit of its rate.
+//!
+//! A target of source `j`, class `c` (speed `v_c`), takeoff angle `α` and
+//! emission time `τ` is at distance `v_c·(t − τ)` from its source at step
+//! `t`. A look at step `t` whose field of view (the part it sees, before
+//! the ray's stop at a building) holds the ray's distances `[a, b]` so
+//! detects, with its `p_detect`, the emission times `[t − b/v_c, t − a/v_c]`.
+//! The chance that the window detects the target is `1 − Π (1 − p)` over
+//! the looks that hold its emission time, so the exposure is
+//! `E_j = Σ_c share_c ∫ dα/spread_j ∫ (1 − Π (1 − p)) dτ`, steps of
+//! emission per unit rate: the window detects `λ_j·E_j` of the source's
+//! targets on average. Every emission time counts, so targets already in
+//! the zone at the window's first step are included.
+//!
+//! `τ` is integrated exactly (a sweep over interval ends); `α` by the
+//! midpoint rule on [`FIT_RAYS_PER_PI`] rays per π over the source's cone.
+
+use rayon::prelude::*;
+
+use crate::geometry::{Point, detection_within};
+use crate::limits::FIT_RAYS_PER_PI;
+use crate::obstacle::Sight;
+use crate::scenario::{Look, Scenario};
+
+/// The looks of a window, oldest step first, with each look's sight (what
+/// its obstacles hide) computed once.
+pub struct WindowLooks<'a> {
+    s: &'a Scenario,
+    /// `(step, look, sight)`, in step order.
+    looks: Vec<(usize, Look, Option<Sight>)>,
+}
+
+impl<'a> WindowLooks<'a> {
+    /// The looks of `steps` (step `i` at time `i`).
+    pub fn new(s: &'a Scenario, steps: &[Vec<Look>]) -> Self {
+        let looks = steps
+            .iter()
+            .enumerate()
+            .flat_map(|(t, looks)| looks.iter().map(move |l| (t, *l)))
+            .map(|(t, l)| (t, l, s.sight(&l)))
+            .collect();
+        WindowLooks { s, looks }
+    }
+
+    /// The number of (look, ray, class) triples the exposure walks: its
+    /// cost.
+    pub fn work(&self) -> usize {
+        (0..self.s.sources.len())
+            .map(|j| {
+                let grid = RayGrid::of(self.s, j);
+                let per_ray = self.s.classes_of(j).len();
+                self.looks
+                    .iter()
+                    .map(|(_, l, _)| {
+                        let (lo, hi) = grid.span(self.s, j, l);
+                        hi.saturating_sub(lo) * per_ray
+                    })
+                    .sum::<usize>()
+            })
+            .sum()
+    }
+
+    /// `E_j` for every source, counting only the targets that a look at a
+    /// step `≥ fresh_from` detects and no earlier look of the window does
+    /// (`fresh_from = 0`: every target the window detects). Targets can be
+    /// counted step by step this way: the exposure of steps `0..=t` is the
+    /// sum over `t' ≤ t` of the exposure of the window ending at `t'` with
+    /// `fresh_from = t'`, and a window only needs the steps in which a
+    /// target seen at its last step can have been in the zone.
+    pub fn exposure(&self, fresh_from: usize) -> Vec<f64> {
+        (0..self.s.sources.len())
+            .map(|j| self.exposure_of(j, fresh_from))
+            .collect()
+    }
+
+    fn exposure_of(&self, j: usize, fresh_from: usize) -> f64 {
+        let s = self.s;
+        let src = &s.sources[j];
+        let classes = s.classes_of(j);
+        let grid = RayGrid::of(s, j);
+        // Looks bucketed by the rays that may cross them (compressed rows).
+        let spans: Vec<(usize, usize)> = self
+            .looks
+            .iter()
+            .map(|(_, l, _)| grid.span(s, j, l))
+            .collect();
+        let mut starts = vec![0usize; grid.n + 1];
+        for &(lo, hi) in &spans {
+            for i in lo..hi {
+                starts[i + 1] += 1;
+            }
+        }
+        for i in 0..grid.n {
+            starts[i + 1] += starts[i];
+        }
+        let mut fill = starts.clone();
+        let mut bucket = vec![0u32; starts[grid.n]];
+        for (li, &(lo, hi)) in spans.iter().enumerate() {
+            for i in lo..hi {
+                bucket[fill[i]] = li as u32;
+                fill[i] += 1;
+            }
+        }
+        // Summed in ray order, so that a fit is the same to the bit on any
+        // number of threads (a registered fit's id depends on it).
+        let per_ray: Vec<f64> = (0..grid.n)
+            .into_par_iter()
+            .map_init(RayScratch::default, |sc, i| {
+                let looks = &bucket[starts[i]..starts[i + 1]];
+                if looks.is_empty() {
+                    return 0.0;
+                }
+                let d = src.direction(grid.angle(i));
+                let inv = Point::new(1.0 / d.x, 1.0 / d.y);
+                let stop = s.obstacles.stop(src.pos, d);
+                sc.pieces.clear();
+                for &li in looks {
+                    let (t, look, sight) = &self.looks[li as usize];
+                    let Some((a, b)) = look.region.ray(src.pos, d, inv) else {
+                        continue;
+                    };
+                    let b = b.min(stop);
+                    if b <= a {
+                        continue;
+                    }
+                    let first = sc.parts.len();
+                    match sight {
+                        Some(sight) => sight.visible(src.pos, d, a, b, &mut sc.parts),
+                        None => sc.parts.push((a, b)),
+                    }
+                    for &(a, b) in &sc.parts[first..] {
+                        sc.pieces.push((*t, a, b, look.p_detect));
+                    }
+                    sc.parts.truncate(first);
+                }
+                classes
+                    .iter()
+                    .map(|c| {
+                        let emitted = |keep: &dyn Fn(usize) -> bool, sc: &mut RayScratch| {
+                            sc.times.clear();
+                            sc.times.extend(sc.pieces.iter().filter(|p| keep(p.0)).map(
+                                |&(t, a, b, p)| (t as f64 - b / c.speed, t as f64 - a / c.speed, p),
+                            ));
+                            detection_within(
+                                &sc.times,
+                                f64::NEG_INFINITY,
+                                f64::INFINITY,
+                                &mut sc.events,
+                            )
+                        };
+                        let all = emitted(&|_| true, sc);
+                        let old = if fresh_from == 0 {
+                            0.0
+                        } else {
+                            emitted(&|t| t < fresh_from, sc)
+                        };
+                        c.share * (all - old).max(0.0)
+                    })
+                    .sum::<f64>()
+            })
+            .collect();
+        per_ray.iter().sum::<f64>() * grid.h / src.spread
+    }
+}
+
+#[derive(Default)]
+struct RayScratch {
+    parts: Vec<(f64, f64)>,
+    pieces: Vec<(usize, f64, f64, f64)>,
+    times: Vec<(f64, f64, f64)>,
+    events: Vec<(f64, f64, bool)>,
+}
+
+/// The midpoint grid of takeoff angles over a source's cone.
+struct RayGrid {
+    /// Number of rays.
+    n: usize,
+    /// Angle between rays.
+    h: f64,
+    /// The cone's first angle.
+    lo: f64,
+}
+
+impl RayGrid {
+    fn of(s: &Scenario, j: usize) -> Self {
+        let src = &s.sources[j];
+        let n =
+            ((src.spread / std::f64::consts::PI * FIT_RAYS_PER_PI as f64).ceil() as usize).max(1);
+        RayGrid {
+            n,
+            h: src.spread / n as f64,
+            lo: src.cone.0,
+        }
+    }
+
+    fn angle(&self, i: usize) -> f64 {
+        self.lo + (i as f64 + 0.5) * self.h
+    }
+
+    /// The rays `lo..hi` whose angles lie within the directions of the
+    /// look's bounding square (a superset of those that cross it).
+    fn span(&self, s: &Scenario, j: usize, look: &Look) -> (usize, usize) {
+        let src = &s.sources[j];
+        let r = &look.region.rect;
+        let (mut a, mut b) = (f64::INFINITY, f64::NEG_INFINITY);
+        for p in [(r.x0, r.y0), (r.x1, r.y0), (r.x0, r.y1), (r.x1, r.y1)] {
+            let angle = src.angle_to(Point::new(p.0, p.1));
+            a = a.min(angle);
+            b = b.max(angle);
+        }
+        // Ray i has angle lo + (i + ½)h.
+        let first = ((a - self.lo) / self.h - 0.5).ceil().max(0.0);
+        let last = ((b - self.lo) / self.h - 0.5).floor();
+        if last < first || first >= self.n as f64 {
+            return (0, 0);
+        }
+        (first as usize, (last as usize + 1).min(self.n))
+    }
+}
