@@ -312,6 +312,18 @@ fn first_detection_pairs(planner: &Planner, input: &PlanInput) -> f64 {
         .sum()
 }
 
+/// Milliseconds per crossing of a fit's exposure (a look, a ray of the
+/// fit's grid that may cross it, a class: [`crate::fit::WindowLooks::work`]),
+/// the slower of the two measured in `docs/learning.md` (*Cost*), rounded
+/// up.
+const FIT_MS_PER_CROSSING: f64 = 7.0e-5;
+
+/// Predicted CPU time of a fit whose exposure walks `crossings` crossings,
+/// milliseconds on one core.
+pub fn fit_ms(crossings: usize) -> f64 {
+    (crossings as f64 * FIT_MS_PER_CROSSING).max(FLOOR_MS)
+}
+
 /// The least either model predicts: every term can be 0 (sources that
 /// emit nothing), the work never is.
 const FLOOR_MS: f64 = 0.01;

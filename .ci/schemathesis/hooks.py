@@ -130,6 +130,22 @@ UNSCHEMATISABLE = [
         "a move is bounded by the previous cell (or the sensor's own) and its type's speed",
     ),
     (
+        r"^steps\[\d+\]\.sensors\[\d+\](: \(.*\) is outside the zone|\.type: unknown sensor type|: cell .* is in (a no-go zone|a building)|\.id: duplicate sensor id)",
+        "a fit window's sensors, under the same rules as a plan's sensors (zone, types, ground, unique ids)",
+    ),
+    (
+        r"^steps\[\d+\]\.detections\[\d+\]: \(.*\) lies outside every field of view of this step",
+        "a detection must lie in a field of view of its step: a relation with the sensors of the same step and the scenario's types",
+    ),
+    (
+        r"^steps\[\d+\]\.detections\[\d+\]\.id: track id .* (jumps|is detected twice)",
+        "a track id's positions across steps are bounded by the scenario's fastest target; unique within a step",
+    ),
+    (
+        r"^steps\[\d+\]\.step: steps must be consecutive",
+        "a relation between items of an array (each step number is the previous one plus one)",
+    ),
+    (
         r"^detections: the session would follow \d+ targets",
         "a bound on the session's tracks: this step's detections plus those kept from earlier steps",
     ),

@@ -62,6 +62,7 @@ pub mod doc;
 pub mod error;
 pub mod evaluate;
 pub mod extract;
+pub mod fit;
 pub mod health;
 pub mod middleware;
 pub mod openapi;
@@ -86,7 +87,7 @@ use tower_http::request_id::{MakeRequestUuid, PropagateRequestIdLayer, SetReques
 use tower_http::trace::{DefaultOnFailure, TraceLayer};
 use tracing::Level;
 
-use crate::limits::MAX_BODY_BYTES;
+use crate::limits::{MAX_BODY_BYTES, MAX_FIT_BODY_BYTES};
 
 pub use error::{ApiError, Problem};
 pub use queue::{QUEUE_PER_WORKER, on_rayon, on_this_worker};
@@ -110,6 +111,11 @@ pub fn router(state: AppState) -> Router {
             get(scenarios::get).delete(scenarios::delete),
         )
         .route("/v1/scenarios/{id}/stats", get(scenarios::stats))
+        .route(
+            "/v1/scenarios/{id}/fit",
+            // A window of observations is larger than a plan request.
+            post(fit::fit).layer(DefaultBodyLimit::max(MAX_FIT_BODY_BYTES)),
+        )
         .route("/v1/scenarios/{id}/plan", post(plan::plan))
         .route("/v1/plan", post(plan::plan_inline))
         .route("/v1/scenarios/{id}/evaluate", post(evaluate::evaluate))

@@ -17,13 +17,13 @@ use utoipa::{Modify, OpenApi};
 
 use super::doc::bounds::Bounds;
 use super::doc::{
-    BadPath, BuiltinScenario, InvalidEvaluateRequest, InvalidInlineEvaluateRequest,
-    InvalidInlinePlanRequest, InvalidPlanRequest, InvalidScenario, InvalidSession, MalformedBody,
-    NotReady, Overloaded, PayloadTooLarge, QueueFull, ScenarioNotFound, SessionNotFound, Timeout,
-    Unauthorized,
+    BadPath, BuiltinScenario, InvalidEvaluateRequest, InvalidFitRequest,
+    InvalidInlineEvaluateRequest, InvalidInlinePlanRequest, InvalidPlanRequest, InvalidScenario,
+    InvalidSession, MalformedBody, NotReady, Overloaded, PayloadTooLarge, QueueFull,
+    ScenarioNotFound, SessionNotFound, Timeout, Unauthorized,
 };
 use super::error::Problem;
-use super::{evaluate, health, middleware, plan, scenarios, sessions};
+use super::{evaluate, fit, health, middleware, plan, scenarios, sessions};
 
 /// Description of the whole API, the `info.description` of the document.
 const DESCRIPTION: &str = "\
@@ -60,6 +60,7 @@ Every error is an RFC 9457 problem (`application/problem+json`, schema \
         scenarios::get,
         scenarios::delete,
         scenarios::stats,
+        fit::fit,
         plan::plan,
         plan::plan_inline,
         evaluate::evaluate,
@@ -82,6 +83,7 @@ Every error is an RFC 9457 problem (`application/problem+json`, schema \
             InvalidInlinePlanRequest,
             InvalidEvaluateRequest,
             InvalidInlineEvaluateRequest,
+            InvalidFitRequest,
             InvalidSession,
             SessionNotFound,
             Unauthorized,

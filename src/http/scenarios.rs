@@ -294,9 +294,20 @@ pub async fn create(
     start: Option<Extension<RequestStart>>,
     Json(spec): Json<ScenarioSpec>,
 ) -> Result<Response, ApiError> {
-    let scenario = Scenario::new(spec)?;
+    let (entry, job, created) = register(&state, start, Scenario::new(spec)?).await?;
+    registered(&entry, job, created)
+}
+
+/// Registers `scenario` (or finds it registered): precomputed at once, or
+/// as a job when predicted above the synchronous budget. Returns its
+/// entry, its job's status if pending, and whether this call created it.
+pub(super) async fn register(
+    state: &AppState,
+    start: Option<Extension<RequestStart>>,
+    scenario: Scenario,
+) -> Result<(Entry, Option<JobStatus>, bool), ApiError> {
     if let Some((entry, job)) = state.registry.entry(&scenario.id) {
-        return registered(&entry, job, false);
+        return Ok((entry, job, false));
     }
     let registry = state.registry.clone();
     if predicted_precompute_ms(&scenario) > registry.limits().sync_precompute_ms {
@@ -306,11 +317,11 @@ pub async fn create(
             .registry
             .entry(entry_id(&entry))
             .and_then(|(_, job)| job);
-        return registered(&entry, job, created);
+        return Ok((entry, job, created));
     }
     // Precompute off the async workers, then store; a 2xx means it is
     // stored. Cancelled (and not stored) if nobody waits for the answer.
-    let guard = CancelOnDrop::new("precompute", start, &state);
+    let guard = CancelOnDrop::new("precompute", start, state);
     let token = guard.token();
     let planner = tokio::task::spawn_blocking(move || {
         let planner = precompute_cancellable(scenario, &token, &Progress::default())
@@ -324,7 +335,23 @@ pub async fn create(
     // one stays, and this answer is 200.
     let (entry, created) = registry.insert(Arc::new(planner)).await?;
     guard.finish();
-    registered(&entry, None, created)
+    Ok((entry, None, created))
+}
+
+/// The status of a registration: 201 for a new ready scenario, 202 for a
+/// pending one (new or not), 200 for one that was ready already.
+pub(super) fn registration_status(entry: &Entry, created: bool) -> StatusCode {
+    match entry {
+        Entry::Pending(_) => StatusCode::ACCEPTED,
+        Entry::Ready(_) if created => StatusCode::CREATED,
+        Entry::Ready(_) => StatusCode::OK,
+    }
+}
+
+/// `Location` of a registered scenario.
+pub(super) fn location(entry: &Entry) -> Result<HeaderValue, ApiError> {
+    HeaderValue::try_from(format!("/v1/scenarios/{}", entry_id(entry)))
+        .map_err(|e| ApiError::Internal(format!("bad Location header: {e}")))
 }
 
 /// The answer to a registration: 201 with `Location` for a new ready
@@ -332,14 +359,11 @@ pub async fn create(
 /// one that was ready already.
 fn registered(entry: &Entry, job: Option<JobStatus>, created: bool) -> Result<Response, ApiError> {
     let body = Json(ScenarioSummary::of(entry, job));
-    let status = match entry {
-        Entry::Pending(_) => StatusCode::ACCEPTED,
-        Entry::Ready(_) if created => StatusCode::CREATED,
-        Entry::Ready(_) => return Ok(body.into_response()),
-    };
-    let location = HeaderValue::try_from(format!("/v1/scenarios/{}", entry_id(entry)))
-        .map_err(|e| ApiError::Internal(format!("bad Location header: {e}")))?;
-    Ok((status, [(header::LOCATION, location)], body).into_response())
+    let status = registration_status(entry, created);
+    if status == StatusCode::OK {
+        return Ok(body.into_response());
+    }
+    Ok((status, [(header::LOCATION, location(entry)?)], body).into_response())
 }
 
 /// `GET /v1/scenarios/{id}` → 200 [`ScenarioSummary`]; 404 if unknown.

@@ -7,6 +7,7 @@ mod bounded;
 mod connections;
 mod errors;
 mod evaluate;
+mod fit;
 mod fleet;
 mod fuzz;
 mod helpers;

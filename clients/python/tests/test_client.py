@@ -121,6 +121,26 @@ def test_evaluate_scores_a_plans_own_paths(vigil: Vigil) -> None:
     assert inline.expected_detections == scored.expected_detections
 
 
+def test_fit_learns_the_rates_of_a_window(vigil: Vigil) -> None:
+    step = lambda x: {  # noqa: E731
+        "sensors": [{"id": "a", "x": x - 5.0, "y": 95.0}],
+        "detections": [{"id": 17, "x": x, "y": 100.0, "vx": 10.0, "vy": 0.0}],
+    }
+    fitted = vigil.fit("paper-v10", {"steps": [step(60.0), step(70.0)], "prior": "flat"})
+    assert (fitted.scenario, fitted.steps, len(fitted.sources)) == ("paper-v10", 2, 8)
+    west = fitted.sources[0]
+    # One target from the source at (-1, 100): Gamma(2, E), mean 2/E.
+    assert west.detected == 1.0
+    assert west.rate == pytest.approx(2.0 / west.exposure, rel=1e-9)
+    assert west.interval[0] < west.rate < west.interval[1]
+    assert fitted.unexplained == []
+    with pytest.raises(VigilError) as outside:
+        vigil.fit("paper-v10", {"steps": [{"sensors": [{"id": "a", "x": 55.0, "y": 95.0}],
+                                           "detections": [{"id": 1, "x": 250.0, "y": 10.0, "vx": 1.0, "vy": 0.0}]}]})
+    assert outside.value.status == 422
+    assert "steps[0].detections[0]" in outside.value.detail
+
+
 def test_a_session_steps_and_is_deleted_at_the_end(vigil: Vigil) -> None:
     with vigil.session("paper-v10", horizon=2, history_steps=4) as session:
         assert session.info.step == 0

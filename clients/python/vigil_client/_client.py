@@ -24,6 +24,7 @@ from .generated.api.planning import evaluate, evaluate_scenario, plan, plan_scen
 from .generated.api.scenarios import (
     create_scenario,
     delete_scenario,
+    fit_scenario,
     get_scenario,
     get_scenario_stats,
     list_scenarios,
@@ -34,6 +35,8 @@ from .generated.models import (
     EvaluateRequestById,
     EvaluateRequestWithScenario,
     EvaluateResponse,
+    FitRequest,
+    FitResponse,
     Health,
     PlanRequest,
     PlanRequestById,
@@ -199,6 +202,12 @@ class Vigil:
         body = _body(request, EvaluateBody)
         return _result(evaluate_scenario.sync_detailed(scenario_id, client=self.client, body=body))
 
+    def fit(self, scenario_id: str, request: FitRequest | Body) -> FitResponse:
+        """`POST /v1/scenarios/{id}/fit`: each source's rate fitted to a window of
+        observations (with `register`, the fitted scenario registered as well)."""
+        body = _body(request, FitRequest)
+        return _result(fit_scenario.sync_detailed(scenario_id, client=self.client, body=body))
+
     def evaluate_inline(
         self, request: EvaluateRequestById | EvaluateRequestWithScenario | Body
     ) -> EvaluateResponse:
@@ -332,6 +341,11 @@ class AsyncVigil:
         """`POST /v1/scenarios/{id}/evaluate`."""
         body = _body(request, EvaluateBody)
         return _result(await evaluate_scenario.asyncio_detailed(scenario_id, client=self.client, body=body))
+
+    async def fit(self, scenario_id: str, request: FitRequest | Body) -> FitResponse:
+        """`POST /v1/scenarios/{id}/fit`."""
+        body = _body(request, FitRequest)
+        return _result(await fit_scenario.asyncio_detailed(scenario_id, client=self.client, body=body))
 
     async def evaluate_inline(
         self, request: EvaluateRequestById | EvaluateRequestWithScenario | Body

@@ -328,3 +328,30 @@ pub fn step_response() -> Value {
         "compute_micros": 1560
     })
 }
+
+/// A fit window of two steps on `paper-v10`: two sensors, one target
+/// detected at both steps.
+pub fn fit_request() -> Value {
+    json!({
+        "steps": [
+            {"sensors": [{"id": "a", "x": 55.0, "y": 95.0}, {"id": "b", "x": 155.0, "y": 105.0}],
+             "detections": [{"id": 17, "x": 60.0, "y": 100.0, "vx": 10.0, "vy": 0.0}]},
+            {"sensors": [{"id": "a", "x": 65.0, "y": 95.0}, {"id": "b", "x": 155.0, "y": 95.0}],
+             "detections": [{"id": 17, "x": 70.0, "y": 100.0, "vx": 10.0, "vy": 0.0}]}
+        ],
+        "prior": "scenario"
+    })
+}
+
+/// What [`fit_request`] gets back (abridged to two sources).
+pub fn fit_response() -> Value {
+    json!({
+        "scenario": "paper-v10",
+        "steps": 2,
+        "sources": [
+            {"index": 0, "rate": 0.081, "interval": [0.0084, 0.27], "detected": 1.0, "exposure": 12.3},
+            {"index": 1, "rate": 0.1, "interval": [0.0, 0.3], "detected": 0.0, "exposure": 0.0}
+        ],
+        "unexplained": []
+    })
+}

@@ -294,3 +294,27 @@ pub struct QueueFull(pub Problem);
     example = json!(problem(ApiError::Timeout))
 )]
 pub struct Timeout(pub Problem);
+
+/// A fit request the scenario cannot take: `detail` starts with the JSON
+/// path of the offending field and a colon.
+#[derive(Debug, ToResponse)]
+#[response(
+    content_type = "application/problem+json",
+    examples(
+        ("outside" = (summary = "A detection no look of its step can have made", value = json!(invalid(
+            "steps[3].detections[0]",
+            "(250, 40) lies outside every field of view of this step: none of its looks can have detected it"
+        )))),
+        ("jump" = (summary = "A track id that jumps", value = json!(invalid(
+            "steps[4].detections[1].id",
+            "track id 17 jumps 180.000 from where it was 1 step(s) before; the fastest target flies 10.000 in that time"
+        )))),
+        ("order" = (summary = "Steps out of order", value = json!(invalid(
+            "steps[2].step", "steps must be consecutive, oldest first: step 7 follows step 9"
+        )))),
+        ("empty" = (summary = "An empty window", value = json!(invalid(
+            "steps", "at least one step: an empty window says nothing about the rates"
+        )))),
+    )
+)]
+pub struct InvalidFitRequest(pub Problem);

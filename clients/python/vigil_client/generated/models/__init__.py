@@ -5,12 +5,17 @@ from .cell_in import CellIn
 from .cell_out import CellOut
 from .coordination import Coordination
 from .database_state import DatabaseState
+from .detection_in import DetectionIn
 from .estimator_kind import EstimatorKind
 from .evaluate_body import EvaluateBody
 from .evaluate_request_by_id import EvaluateRequestById
 from .evaluate_request_with_scenario import EvaluateRequestWithScenario
 from .evaluate_response import EvaluateResponse
 from .explain import Explain
+from .fit_request import FitRequest
+from .fit_response import FitResponse
+from .fit_step import FitStep
+from .fit_tolerance import FitTolerance
 from .fov_spec_type_0 import FovSpecType0
 from .fov_spec_type_0_shape import FovSpecType0Shape
 from .fov_spec_type_1 import FovSpecType1
@@ -31,7 +36,9 @@ from .plan_request import PlanRequest
 from .plan_request_by_id import PlanRequestById
 from .plan_request_with_scenario import PlanRequestWithScenario
 from .plan_response import PlanResponse
+from .point_out import PointOut
 from .position_in import PositionIn
+from .prior_kind import PriorKind
 from .problem import Problem
 from .scenario_list import ScenarioList
 from .scenario_spec import ScenarioSpec
@@ -47,6 +54,7 @@ from .session_info import SessionInfo
 from .session_request_by_id import SessionRequestById
 from .session_request_with_scenario import SessionRequestWithScenario
 from .session_settings import SessionSettings
+from .source_rate import SourceRate
 from .source_spec import SourceSpec
 from .speed_spec import SpeedSpec
 from .step_request import StepRequest
@@ -54,6 +62,7 @@ from .step_response import StepResponse
 from .summary_stats import SummaryStats
 from .target_in import TargetIn
 from .track import Track
+from .unexplained import Unexplained
 from .zone_spec import ZoneSpec
 
 __all__ = (
@@ -62,12 +71,17 @@ __all__ = (
     "CellOut",
     "Coordination",
     "DatabaseState",
+    "DetectionIn",
     "EstimatorKind",
     "EvaluateBody",
     "EvaluateRequestById",
     "EvaluateRequestWithScenario",
     "EvaluateResponse",
     "Explain",
+    "FitRequest",
+    "FitResponse",
+    "FitStep",
+    "FitTolerance",
     "FovSpecType0",
     "FovSpecType0Shape",
     "FovSpecType1",
@@ -88,7 +102,9 @@ __all__ = (
     "PlanRequestById",
     "PlanRequestWithScenario",
     "PlanResponse",
+    "PointOut",
     "PositionIn",
+    "PriorKind",
     "Problem",
     "ScenarioList",
     "ScenarioSpec",
@@ -104,6 +120,7 @@ __all__ = (
     "SessionRequestById",
     "SessionRequestWithScenario",
     "SessionSettings",
+    "SourceRate",
     "SourceSpec",
     "SpeedSpec",
     "StepRequest",
@@ -111,5 +128,6 @@ __all__ = (
     "SummaryStats",
     "TargetIn",
     "Track",
+    "Unexplained",
     "ZoneSpec",
 )

@@ -1,0 +1,188 @@
+//! Fitting source rates over HTTP (`POST /v1/scenarios/{id}/fit`).
+
+use reqwest::StatusCode;
+use serde_json::{Value, json};
+
+use crate::helpers::{assert_problem, assert_validation, json_body, spawn_app};
+
+fn fit_request() -> Value {
+    vigil::http::doc::examples::fit_request()
+}
+
+#[tokio::test]
+async fn a_window_gets_each_sources_rate_with_its_interval() {
+    let app = spawn_app().await;
+    let res = app
+        .post_json("/v1/scenarios/paper-v10/fit", &fit_request())
+        .await;
+    let body = json_body(res, StatusCode::OK).await;
+    assert_eq!(body["scenario"], "paper-v10");
+    assert_eq!(body["steps"], 2);
+    let sources = body["sources"].as_array().unwrap();
+    assert_eq!(sources.len(), 8);
+    for (i, s) in sources.iter().enumerate() {
+        assert_eq!(s["index"], i);
+        let rate = s["rate"].as_f64().unwrap();
+        let [lo, hi] = [
+            s["interval"][0].as_f64().unwrap(),
+            s["interval"][1].as_f64().unwrap(),
+        ];
+        assert!(lo <= rate && rate <= hi, "{s}");
+        assert!(s["exposure"].as_f64().unwrap() >= 0.0, "{s}");
+    }
+    // Target 17 flies east along y = 100 from the source at (-1, 100): it
+    // counts once, for that source, which the looks expose.
+    assert_eq!(sources[0]["detected"], 1.0);
+    assert!(sources[0]["exposure"].as_f64().unwrap() > 0.0);
+    let total: f64 = sources
+        .iter()
+        .map(|s| s["detected"].as_f64().unwrap())
+        .sum();
+    assert_eq!(total, 1.0);
+    assert_eq!(body["unexplained"], json!([]));
+    assert!(body.get("id").is_none());
+    // A flat prior: Gamma(N + 1, E), mean (N + 1)/E.
+    let mut req = fit_request();
+    req["prior"] = json!("flat");
+    let flat = json_body(
+        app.post_json("/v1/scenarios/paper-v10/fit", &req).await,
+        StatusCode::OK,
+    )
+    .await;
+    let s0 = &flat["sources"][0];
+    let e = s0["exposure"].as_f64().unwrap();
+    assert!((s0["rate"].as_f64().unwrap() - 2.0 / e).abs() < 1e-9 * (2.0 / e));
+}
+
+#[tokio::test]
+async fn a_target_from_no_source_is_unexplained_with_its_entry() {
+    let app = spawn_app().await;
+    let mut req = fit_request();
+    // Eastbound along y = 40: no paper source lies on that line.
+    for (i, step) in req["steps"].as_array_mut().unwrap().iter_mut().enumerate() {
+        step["sensors"][0]["y"] = json!(45.0);
+        step["detections"][0]["y"] = json!(40.0);
+        step["detections"][0]["x"] = json!(60.0 + 10.0 * i as f64);
+    }
+    let body = json_body(
+        app.post_json("/v1/scenarios/paper-v10/fit", &req).await,
+        StatusCode::OK,
+    )
+    .await;
+    assert_eq!(
+        body["unexplained"],
+        json!([{"id": 17, "entry": {"x": 0.0, "y": 40.0}}])
+    );
+}
+
+#[tokio::test]
+async fn register_adds_the_fitted_scenario() {
+    let app = spawn_app().await;
+    let mut req = fit_request();
+    req["register"] = json!(true);
+    let res = app.post_json("/v1/scenarios/paper-v10/fit", &req).await;
+    let location = res.headers()["location"].to_str().unwrap().to_owned();
+    let body = json_body(res, StatusCode::CREATED).await;
+    let id = body["id"].as_str().unwrap();
+    assert_eq!(location, format!("/v1/scenarios/{id}"));
+    let summary = json_body(app.get(&location).await, StatusCode::OK).await;
+    for (src, fitted) in summary["spec"]["sources"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(body["sources"].as_array().unwrap())
+    {
+        assert_eq!(src["rate"], fitted["rate"]);
+    }
+    // The same fit again finds it registered: 200, the same id.
+    let again = json_body(
+        app.post_json("/v1/scenarios/paper-v10/fit", &req).await,
+        StatusCode::OK,
+    )
+    .await;
+    assert_eq!(again["id"], body["id"]);
+}
+
+#[tokio::test]
+async fn bad_windows_are_refused_naming_the_field() {
+    let app = spawn_app().await;
+    let url = "/v1/scenarios/paper-v10/fit";
+    assert_validation(app.post_json(url, &json!({"steps": []})).await, "steps").await;
+    let mut outside = fit_request();
+    outside["steps"][1]["detections"][0]["x"] = json!(250.0);
+    assert_validation(app.post_json(url, &outside).await, "steps[1].detections[0]").await;
+    let mut jump = fit_request();
+    jump["steps"][1]["sensors"][1] = json!({"id": "b", "x": 155.0, "y": 105.0});
+    jump["steps"][1]["detections"][0] =
+        json!({"id": 17, "x": 160.0, "y": 100.0, "vx": 10.0, "vy": 0.0});
+    assert_validation(app.post_json(url, &jump).await, "steps[1].detections[0].id").await;
+    let mut order = fit_request();
+    order["steps"][0]["step"] = json!(9);
+    order["steps"][1]["step"] = json!(7);
+    assert_validation(app.post_json(url, &order).await, "steps[1].step").await;
+    let mut ty = fit_request();
+    ty["steps"][0]["sensors"][0]["type"] = json!("blimp");
+    assert_validation(app.post_json(url, &ty).await, "steps[0].sensors[0].type").await;
+    let mut tol = fit_request();
+    tol["tolerance"] = json!({"traceback": -1.0});
+    assert_validation(app.post_json(url, &tol).await, "tolerance.traceback").await;
+    let mut unknown = fit_request();
+    unknown["steps"][0]["detections"][0]["z"] = json!(1.0);
+    let res = app.post_json(url, &unknown).await;
+    assert!(res.status().is_client_error(), "{}", res.status());
+    assert_problem(
+        app.post_json("/v1/scenarios/nope/fit", &fit_request())
+            .await,
+        StatusCode::NOT_FOUND,
+        "nope",
+    )
+    .await;
+}
+
+#[tokio::test]
+async fn a_long_window_fits_past_the_plan_body_limit() {
+    let app = spawn_app().await;
+    // 500 steps of 64 sensors with long ids: about 6 MB, past the 4 MB a
+    // plan may send. `spread` sensors stand on distinct cells.
+    let window = |spread: usize| {
+        let steps: Vec<Value> = (0..500)
+            .map(|_| {
+                let sensors: Vec<Value> = (0..64)
+                    .map(|i| {
+                        let k = i % spread;
+                        json!({"id": format!("{i:0>120}"), "x": 55.0 + 10.0 * (k % 8) as f64,
+                               "y": 55.0 + 10.0 * (k / 8) as f64})
+                    })
+                    .collect();
+                json!({"sensors": sensors, "detections": []})
+            })
+            .collect();
+        json!({"steps": steps})
+    };
+    // 64 distinct looks a step over 500 steps is more work than a server
+    // takes: refused as a costly plan is.
+    assert_problem(
+        app.post_json("/v1/scenarios/paper-v10/fit", &window(64))
+            .await,
+        StatusCode::UNPROCESSABLE_ENTITY,
+        "--max-plan-ms",
+    )
+    .await;
+    let req = window(2);
+    assert!(req.to_string().len() > vigil::limits::MAX_BODY_BYTES);
+    let body = json_body(
+        app.post_json("/v1/scenarios/paper-v10/fit", &req).await,
+        StatusCode::OK,
+    )
+    .await;
+    assert_eq!(body["steps"], 500);
+    // Nothing detected over a long watch: every well exposed rate falls.
+    let mut exposed = 0;
+    for s in body["sources"].as_array().unwrap() {
+        if s["exposure"].as_f64().unwrap() > 50.0 {
+            exposed += 1;
+            assert!(s["rate"].as_f64().unwrap() < 0.3 / 2.0, "{s}");
+        }
+    }
+    assert!(exposed > 0, "{body}");
+}
