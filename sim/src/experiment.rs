@@ -14,6 +14,7 @@ use crate::client::{Client, ClientError};
 use crate::driver::{Sim, Start, checked_bound, fleet_types};
 use crate::metrics::{Metrics, RunAccumulator, StepCount, summarize};
 use crate::policy::{ALL_POLICIES, Policy};
+use crate::rates::WorldRates;
 
 /// Everything that defines one run but its seed.
 #[derive(Debug, Clone)]
@@ -57,6 +58,13 @@ pub struct RunConfig {
     /// the world forbids (a ground sensor onto a building's cell) becomes
     /// the legal move nearest to it ([`Sim::blind`]).
     pub blind: bool,
+    /// The world's sources emit at other rates than the planner is told
+    /// (`--world-rates`): `scenario`, the world, already has its sources'
+    /// rates scaled by these factors (see [`crate::rates::world_scenario`]);
+    /// `scenario_id` is the scenario as given unless `told`, when it was
+    /// registered with the world's rates. Recorded in the report; `None`:
+    /// the world emits at the rates the planner is told.
+    pub world_rates: Option<WorldRates>,
 }
 
 impl RunConfig {
@@ -221,6 +229,13 @@ pub struct Row {
     pub min_separation: usize,
     /// Seeds averaged.
     pub seeds: usize,
+    /// The factors of the world's sources' rates over the scenario's, one
+    /// per source (`--world-rates`); null when the world emits at the
+    /// scenario's rates.
+    pub world_rates: Option<Vec<f64>>,
+    /// The planner was told the world's rates (`--tell-world-rates`:
+    /// `scenario` is the spec registered with them), not the scenario's.
+    pub told_world_rates: bool,
     /// Means over seeds.
     pub metrics: Metrics,
     /// Half-widths of the 95% confidence intervals.
@@ -287,6 +302,8 @@ pub async fn run_all(
                 steps: cfg.steps,
                 min_separation: cfg.separation(),
                 seeds: runs.len(),
+                world_rates: cfg.world_rates.as_ref().map(|w| w.scales.clone()),
+                told_world_rates: cfg.world_rates.as_ref().is_some_and(|w| w.told),
                 metrics,
                 ci95,
             }

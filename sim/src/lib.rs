@@ -7,6 +7,8 @@
 //! - [`client`]: the HTTP client, and an in-process server for one-command runs;
 //! - [`experiment`]: runs over seeds and the paper's experiment grids;
 //! - [`live`]: the live view, one run watched in a browser;
+//! - [`rates`]: a world whose sources emit at other rates than the planner
+//!   is told;
 //! - [`report`]: the paper's table layout and JSON output;
 //! - [`svg`]: a picture of one run, like the paper's Figure 3.
 
@@ -16,5 +18,6 @@ pub mod experiment;
 pub mod live;
 pub mod metrics;
 pub mod policy;
+pub mod rates;
 pub mod report;
 pub mod svg;

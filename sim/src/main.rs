@@ -11,6 +11,8 @@
 //! vigil-sim --policy exact --sensors 10 --svg run.svg
 //! vigil-sim --live --policy exact --sensors 10      # watch one run in a browser
 //! vigil-sim --experiment table1 --min-separation 3 # sensors ≥ 3 cells apart
+//! vigil-sim --policy exact --world-rates 3          # the world emits 3× what the planner is told
+//! vigil-sim --policy exact --world-rates 3 --tell-world-rates   # … and the planner is told
 //! ```
 //! Without `--server` it starts a server in-process on a loopback port and
 //! still talks HTTP to it.
@@ -27,6 +29,7 @@ use vigil_sim::experiment::{
 };
 use vigil_sim::live::{Live, LiveOptions};
 use vigil_sim::policy::Policy;
+use vigil_sim::rates::{RateScales, WorldRates, world_scenario};
 use vigil_sim::{report, svg};
 
 /// Command-line options.
@@ -129,6 +132,20 @@ struct Args {
     /// sensor onto a building's cell) becomes the legal move nearest to it.
     #[arg(long)]
     blind: bool,
+    /// The world's sources emit at other rates than the planner is told:
+    /// source j of the scenario emits at its rate (its total over its
+    /// speeds) times the j-th factor. Comma-separated factors ≥ 0, one per
+    /// source in the scenario's order (e.g. `3,0.3,1,0`; 0 silences a
+    /// source), or one for every source (e.g. `2`). The planner is still
+    /// told the scenario as it is, unless `--tell-world-rates`. With
+    /// `--experiment`, applied to each row's scenario.
+    #[arg(long, value_name = "SCALES", allow_hyphen_values = true, value_parser = RateScales::parse)]
+    world_rates: Option<RateScales>,
+    /// With `--world-rates`: tell the planner the world's rates, asking for
+    /// plans of the scenario registered with them (the control of a
+    /// planner told the wrong rates).
+    #[arg(long)]
+    tell_world_rates: bool,
 }
 
 #[tokio::main]
@@ -168,13 +185,10 @@ async fn resolve(client: &Client, scenario: &str) -> Result<(String, Scenario), 
     Ok((info.id, local))
 }
 
-/// Registers `scenario` without its obstacles and gives its id.
-async fn blind_to_obstacles(client: &Client, scenario: &Scenario) -> Result<String, String> {
-    let spec = ScenarioSpec {
-        obstacles: None,
-        ..scenario.spec.clone()
-    };
-    let info = client.register(&spec).await.map_err(|e| e.to_string())?;
+/// Registers `spec` (or finds it registered), waits until it is ready and
+/// gives its id.
+async fn register(client: &Client, spec: &ScenarioSpec) -> Result<String, String> {
+    let info = client.register(spec).await.map_err(|e| e.to_string())?;
     let info = client
         .wait_ready(info, |_| {})
         .await
@@ -182,7 +196,92 @@ async fn blind_to_obstacles(client: &Client, scenario: &Scenario) -> Result<Stri
     Ok(info.id)
 }
 
+/// What a run judges its plans in, and what its planner is told.
+#[derive(Debug, Clone)]
+struct WorldAndTold {
+    /// The id of the scenario the planner is told.
+    told_id: String,
+    /// The world.
+    world: Scenario,
+    /// The world's rates, when they are not the scenario's.
+    world_rates: Option<WorldRates>,
+}
+
+/// The world and the told scenario of a run on `scenario` (id `id`): the
+/// world is `scenario` with its sources' rates scaled by `rates`, when
+/// given; the planner is told `id` itself, or a spec registered with the
+/// world's rates when `tell`, without obstacles when `blind`.
+async fn world_and_told(
+    client: &Client,
+    id: String,
+    scenario: Scenario,
+    rates: Option<&RateScales>,
+    tell: bool,
+    blind: bool,
+) -> Result<WorldAndTold, String> {
+    if blind && !scenario.has_obstacles() {
+        return Err(format!("--blind: {id} has no obstacles to be blind to"));
+    }
+    let world_rates = match rates {
+        Some(rates) => {
+            let scales = rates
+                .per_source(scenario.sources.len())
+                .map_err(|e| format!("--world-rates: {id}: {e}"))?;
+            Some(WorldRates { scales, told: tell })
+        }
+        None => None,
+    };
+    let own = scenario.spec.clone();
+    let world = match &world_rates {
+        Some(w) => world_scenario(&scenario, &w.scales)
+            .map_err(|e| format!("--world-rates: {id} at the world's rates: {e}"))?,
+        None => scenario,
+    };
+    // The spec the planner is told, when not `id`'s own: the world's rates,
+    // no obstacles, or both.
+    let told = (tell || blind).then(|| {
+        let spec = if tell { world.spec.clone() } else { own };
+        if blind {
+            ScenarioSpec {
+                obstacles: None,
+                ..spec
+            }
+        } else {
+            spec
+        }
+    });
+    let told_id = match told {
+        Some(spec) => register(client, &spec).await?,
+        None => id.clone(),
+    };
+    if let Some(w) = &world_rates {
+        let scales: Vec<String> = w.scales.iter().map(f64::to_string).collect();
+        let planner = if w.told {
+            format!("the world's rates (registered as {told_id})")
+        } else if told_id != id {
+            format!("{id}'s own rates (as {told_id})")
+        } else {
+            format!("{id}'s own rates")
+        };
+        eprintln!(
+            "vigil-sim: {id}'s sources emit at their rates × [{}] in the world; the planner is told {planner}",
+            scales.join(", ")
+        );
+    }
+    Ok(WorldAndTold {
+        told_id,
+        world,
+        world_rates,
+    })
+}
+
 async fn run(args: Args) -> Result<(), String> {
+    if args.tell_world_rates && args.world_rates.is_none() {
+        return Err(
+            "--tell-world-rates tells the planner the world's rates: give them with --world-rates"
+                .into(),
+        );
+    }
     let base = match &args.server {
         Some(url) => url.clone(),
         None => spawn_local_server()
@@ -190,27 +289,26 @@ async fn run(args: Args) -> Result<(), String> {
             .map_err(|e| format!("cannot start a server: {e}"))?,
     };
     let client = Client::new(&base);
-    let config = |label: String,
-                  policy: Policy,
-                  id: String,
-                  scenario: Scenario,
-                  sensors: usize,
-                  fleet: Option<&str>| RunConfig {
-        label,
-        policy,
-        warmup: args.warmup.unwrap_or_else(|| default_warmup(&scenario)),
-        scenario_id: id,
-        scenario,
-        sensors,
-        fleet: fleet.map(str::to_owned),
-        steps: args.steps,
-        horizon: args.horizon,
-        history: args.history.into(),
-        start: args.start,
-        min_separation: args.min_separation.map(usize::from),
-        session: args.session,
-        blind: args.blind,
-    };
+    let config =
+        |label: String, policy: Policy, on: &WorldAndTold, sensors: usize, fleet: Option<&str>| {
+            RunConfig {
+                label,
+                policy,
+                warmup: args.warmup.unwrap_or_else(|| default_warmup(&on.world)),
+                scenario_id: on.told_id.clone(),
+                scenario: on.world.clone(),
+                sensors,
+                fleet: fleet.map(str::to_owned),
+                steps: args.steps,
+                horizon: args.horizon,
+                history: args.history.into(),
+                start: args.start,
+                min_separation: args.min_separation.map(usize::from),
+                session: args.session,
+                blind: args.blind,
+                world_rates: on.world_rates.clone(),
+            }
+        };
     if args.blind && args.experiment.is_some() {
         return Err("--blind is a control of a single run; drop --experiment".into());
     }
@@ -220,15 +318,32 @@ async fn run(args: Args) -> Result<(), String> {
             let policies = chosen_policies(name, &args.policy).ok_or_else(unknown)?;
             let grid = experiment_grid(name).ok_or_else(unknown)?;
             let mut configs = Vec::new();
-            for (n, (sensors, id)) in grid.iter().enumerate() {
-                let (id, scenario) = resolve(&client, id).await?;
+            // Each scenario of the grid once (rows share them).
+            let mut resolved: Vec<(&str, WorldAndTold)> = Vec::new();
+            for (n, &(sensors, name)) in grid.iter().enumerate() {
+                let on = match resolved.iter().find(|r| r.0 == name) {
+                    Some((_, on)) => on.clone(),
+                    None => {
+                        let (id, scenario) = resolve(&client, name).await?;
+                        let on = world_and_told(
+                            &client,
+                            id,
+                            scenario,
+                            args.world_rates.as_ref(),
+                            args.tell_world_rates,
+                            false,
+                        )
+                        .await?;
+                        resolved.push((name, on.clone()));
+                        on
+                    }
+                };
                 for &(letter, policy) in &policies {
                     configs.push(config(
                         format!("{}{letter}", n + 1),
                         policy,
-                        id.clone(),
-                        scenario.clone(),
-                        *sensors,
+                        &on,
+                        sensors,
                         experiment_fleet(name, n),
                     ));
                 }
@@ -236,13 +351,16 @@ async fn run(args: Args) -> Result<(), String> {
             configs
         }
         None => {
-            let (mut id, scenario) = resolve(&client, &args.scenario).await?;
-            if args.blind {
-                if !scenario.has_obstacles() {
-                    return Err(format!("--blind: {id} has no obstacles to be blind to"));
-                }
-                id = blind_to_obstacles(&client, &scenario).await?;
-            }
+            let (id, scenario) = resolve(&client, &args.scenario).await?;
+            let on = world_and_told(
+                &client,
+                id,
+                scenario,
+                args.world_rates.as_ref(),
+                args.tell_world_rates,
+                args.blind,
+            )
+            .await?;
             let sensors = match &args.fleet {
                 Some(fleet) => fleet_size(fleet)
                     .ok_or_else(|| format!("--fleet {fleet:?}: expected NAME:COUNT,…"))?,
@@ -263,8 +381,7 @@ async fn run(args: Args) -> Result<(), String> {
                     config(
                         policy.name().to_owned(),
                         policy,
-                        id.clone(),
-                        scenario.clone(),
+                        &on,
                         sensors,
                         args.fleet.as_deref(),
                     )

@@ -95,7 +95,8 @@ pub fn table(rows: &[Row]) -> String {
 }
 
 /// The JSON report: `{"runs":[{label, policy, scenario, sensors, fleet,
-/// target_speed, steps, min_separation, seeds, metrics, ci95}]}`.
+/// target_speed, steps, min_separation, seeds, world_rates,
+/// told_world_rates, metrics, ci95}]}`.
 pub fn json(rows: &[Row]) -> serde_json::Result<String> {
     #[derive(Serialize)]
     struct Report<'a> {

@@ -27,6 +27,7 @@ fn config(policy: Policy, id: &str, scenario: &Scenario, steps: usize) -> RunCon
         min_separation: None,
         session: false,
         blind: false,
+        world_rates: None,
     }
 }
 

@@ -164,6 +164,7 @@ async fn live_view_in_headless_chromium() {
         min_separation: None,
         session: false,
         blind: false,
+        world_rates: None,
     };
     let listener = tokio::net::TcpListener::bind("127.0.0.1:0")
         .await
@@ -435,6 +436,7 @@ async fn live_view_draws_obstacles_and_views() {
         min_separation: None,
         session: false,
         blind: false,
+        world_rates: None,
     };
     let listener = tokio::net::TcpListener::bind("127.0.0.1:0")
         .await

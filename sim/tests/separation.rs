@@ -364,6 +364,7 @@ async fn uncoordinated_planner_keeps_apart_in_closed_loop() {
         min_separation: Some(d),
         session: false,
         blind: false,
+        world_rates: None,
     };
     let mut means = Vec::new();
     for d in [0, 3] {

@@ -153,6 +153,7 @@ async fn vigil_sim_through_sessions_gives_the_same_metrics() {
         min_separation: None,
         session,
         blind: false,
+        world_rates: None,
     };
     for seed in [1, 2] {
         let (stateless, _) = run_one(&client, &cfg(false), seed, false)

@@ -174,6 +174,7 @@ async fn end_to_end_over_http() {
             min_separation: None,
             session: false,
             blind: false,
+            world_rates: None,
         })
         .collect();
     let rows = run_all(&client, &configs, 7, 2, 4).await.expect("runs");
@@ -398,6 +399,7 @@ async fn fleets_move_within_their_speeds_around_no_go_zones() {
         min_separation: None,
         session: false,
         blind: false,
+        world_rates: None,
     };
     let (metrics, sim) = run_one(&client, &cfg, 5, true).await.expect("run");
     let sim = sim.expect("kept");
@@ -549,6 +551,7 @@ async fn site_campus_runs_aware_and_blind() {
         min_separation: None,
         session: false,
         blind,
+        world_rates: None,
     };
     let mut calibration = Vec::new();
     for (id, blind) in [(info.id.as_str(), false), (blind.id.as_str(), true)] {
