@@ -113,3 +113,13 @@ pub const DEFAULT_FIT_SPEED_TOLERANCE: f64 = 1e-6;
 /// Most distinct tracks a learning session remembers (each counts once
 /// for the session's life); past it the oldest are forgotten.
 pub const MAX_SESSION_TRACKS: usize = 1_000_000;
+/// Most steps of looks a learning session keeps to count its exposure: a
+/// target seen now can have been seen before only while it was in the
+/// zone, so a session keeps the steps its slowest target needs to cross
+/// the zone's diagonal, up to this many.
+pub const MAX_LEARN_MEMORY_STEPS: usize = 1000;
+/// A learning session plans with a scenario at its learnt rates, rebuilt
+/// (its statistics precomputed again) when a source's posterior mean moves
+/// from the rate planned with by more than this share of that rate (or of
+/// the sources' mean rate, when larger).
+pub const LEARN_REPLAN_DRIFT: f64 = 0.05;

@@ -22,6 +22,11 @@
 //! That is the rule the simulation client applies to build its stateless
 //! requests, so a session's plan equals the stateless plan of the same run.
 //!
+//! A session created with `learn_rates` also learns the sources' rates
+//! ([`crate::fit::RateLearner`]): each step is folded in before its plan,
+//! which is then made at the learnt rates (the stateless plan of the same
+//! state on the scenario at those rates).
+//!
 //! ```
 //! use std::sync::Arc;
 //! use vigil::planner::{Planner, SensorIn, TargetIn, Id};
@@ -50,13 +55,14 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::coordination::{Coordination, Objective};
+use crate::fit::{FitTolerance, LearntStep, RateLearner, Tolerances};
 use crate::geometry::Point;
 use crate::limits::{DEFAULT_HISTORY_STEPS, MAX_HISTORY_STEPS, MAX_TARGETS};
 use crate::planner::{
     EstimatorKind, Id, Observed, PlanRequest, Planner, PositionIn, SensorIn, TargetIn,
 };
 use crate::planner::{check_certify, check_objective};
-use crate::scenario::{Integer, ValidationError};
+use crate::scenario::{Integer, Scenario, ValidationError};
 
 /// A session's defaults for its steps; a step may override each but
 /// `history_steps`.
@@ -94,9 +100,28 @@ pub struct SessionSettings {
     /// `certify`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub certify: Option<bool>,
+    /// Learn the sources' rates from the detections (false by default):
+    /// every step then needs an `id` on each detection, folds its looks
+    /// and new targets into each source's posterior (the scenario's prior;
+    /// see `docs/learning.md`), plans with the posterior means and reports
+    /// them as `rates`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub learn_rates: Option<bool>,
+    /// With `learn_rates`: the tolerances of a noisy tracker, as in a fit
+    /// (exact data by default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<FitTolerance>,
 }
 
 impl SessionSettings {
+    /// The learning tolerances against scenario `s`.
+    ///
+    /// # Errors
+    /// A [`ValidationError`] naming `tolerance.traceback` (…).
+    pub fn tolerances(&self, s: &Scenario) -> Result<Tolerances, ValidationError> {
+        Tolerances::new(s, self.tolerance.as_ref())
+    }
+
     /// Checks what can be checked before any step: `history_steps`, an
     /// `objective` the `estimator` cannot serve, and `certify: false` with
     /// `joint` (the rest is checked with every step's plan request). Gives
@@ -252,6 +277,9 @@ pub struct Session {
     /// Sensors' positions 1, 2, … steps ago.
     history: VecDeque<Vec<PositionIn>>,
     tracks: Vec<Track>,
+    /// With `learn_rates`: the rates learnt so far. Shared so a step can
+    /// fold into it off the async workers; unique again once it is done.
+    learner: Option<Arc<RateLearner>>,
 }
 
 impl Session {
@@ -263,6 +291,15 @@ impl Session {
             .history_len()
             .unwrap_or(DEFAULT_HISTORY_STEPS)
             .min(MAX_HISTORY_STEPS);
+        let learner = (settings.learn_rates == Some(true)).then(|| {
+            // Checked at creation (`SessionSettings::tolerances`); the
+            // defaults otherwise.
+            let tolerances = settings
+                .tolerances(&planner.scenario)
+                .or_else(|_| Tolerances::new(&planner.scenario, None))
+                .unwrap_or_else(|_| unreachable!("the default tolerances are valid"));
+            Arc::new(RateLearner::new(planner.clone(), tolerances))
+        });
         Self {
             planner,
             settings,
@@ -270,6 +307,30 @@ impl Session {
             step: 0,
             history: VecDeque::new(),
             tracks: Vec::new(),
+            learner,
+        }
+    }
+
+    /// With `learn_rates`: its learnt rates.
+    pub fn learner(&self) -> Option<&Arc<RateLearner>> {
+        self.learner.as_ref()
+    }
+
+    /// The planner of a step: its scenario's, or the one at the rates it
+    /// learnt (`learnt`, this step's fold, first).
+    pub fn planner_for(&self, learnt: Option<&LearntStep>) -> Arc<Planner> {
+        learnt
+            .and_then(LearntStep::planner)
+            .or_else(|| self.learner.as_ref().map(|l| l.planner()))
+            .unwrap_or(&self.planner)
+            .clone()
+    }
+
+    /// Records this step's fold ([`RateLearner::fold`]) once its plan is
+    /// made.
+    pub fn commit_learnt(&mut self, learnt: LearntStep) {
+        if let Some(learner) = &mut self.learner {
+            Arc::make_mut(learner).commit(learnt);
         }
     }
 
@@ -321,6 +382,7 @@ impl Session {
             + self.history.capacity() * std::mem::size_of::<Vec<PositionIn>>()
             + positions
             + self.tracks.capacity() * std::mem::size_of::<Track>()
+            + self.learner.as_ref().map_or(0, |l| l.memory_bytes())
     }
 
     /// Steps 1–4 of the module docs: the tracks this step leads to and the

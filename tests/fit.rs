@@ -455,3 +455,113 @@ fn a_target_from_an_unlisted_gate_is_unexplained_near_it() {
     }
     assert_eq!(fitted.sources.len(), 4);
 }
+
+#[test]
+fn a_learning_session_counts_what_a_window_fit_counts() {
+    let spec = yard(true);
+    let s = scenario(spec.clone());
+    let world_s = scenario(scaled(spec, &[3.0, 1.0 / 3.0, 1.0, 0.0]));
+    let base = Arc::new(Planner::new(s.clone()));
+    let settings = SessionSettings {
+        learn_rates: Some(true),
+        ..SessionSettings::default()
+    };
+    let mut session = Session::new(base.clone(), settings);
+    let memory = session.learner().unwrap().memory();
+    let steps = memory + 20;
+    let mut rng = StdRng::seed_from_u64(3);
+    let mut world = World::stationary(&world_s, &mut rng);
+    let mut sensors: Vec<SensorIn> = FLEET
+        .iter()
+        .enumerate()
+        .map(|(i, ty)| SensorIn {
+            id: Id::Number((i as u64).into()),
+            x: 25.0 + 40.0 * i as f64,
+            y: 45.0,
+            sensor_type: Some(ty.to_string()),
+        })
+        .collect();
+    let mut window = Vec::new();
+    let mut replanned = 0;
+    for _ in 0..steps {
+        let detections = detect(&world_s, &world, &sensors, &mut rng);
+        window.push(FitStep {
+            step: None,
+            sensors: sensors.clone(),
+            detections: detections.clone(),
+        });
+        let step = StepRequest {
+            sensors: sensors.clone(),
+            detections: detections
+                .into_iter()
+                .map(|d| TargetIn {
+                    id: Some(d.id),
+                    x: d.x,
+                    y: d.y,
+                    vx: d.vx,
+                    vy: d.vy,
+                })
+                .collect(),
+            ..StepRequest::default()
+        };
+        let learnt = session
+            .learner()
+            .unwrap()
+            .fold(&step.sensors, &step.detections)
+            .unwrap();
+        let planner = session.planner_for(Some(&learnt));
+        if !Arc::ptr_eq(&planner, session.learner().unwrap().planner()) {
+            replanned += 1;
+        }
+        let prepared = session.prepare(&step);
+        let plan = planner.plan_request(&prepared.request).unwrap();
+        session.commit(prepared);
+        session.commit_learnt(learnt);
+        for (sensor, p) in sensors.iter_mut().zip(&plan.plans) {
+            let c = s.centre(vigil::scenario::Cell {
+                col: p.path[0].col,
+                row: p.path[0].row,
+            });
+            (sensor.x, sensor.y) = (c.x, c.y);
+        }
+        world.step(&world_s, &mut rng);
+    }
+    // The plans moved to the learnt rates, away from the spec's.
+    assert!(replanned > 0);
+    let planned = session.learner().unwrap().planner().scenario.sources[0].rate;
+    assert!(planned > 1.5 * s.sources[0].rate, "{planned}");
+    // Step by step, over a life longer than a target's stay, the session
+    // counts what a fit of its whole life counts.
+    let learnt = session.learner().unwrap().rates();
+    let req = FitRequest {
+        steps: window,
+        ..FitRequest::default()
+    };
+    let fitted = vigil::fit::fit(&s, &FitWindow::new(&s, &req).unwrap());
+    for (a, b) in learnt.iter().zip(&fitted.sources) {
+        assert!(
+            (a.exposure - b.exposure).abs() < 1e-9 * b.exposure.max(1.0),
+            "{a:?} {b:?}"
+        );
+        assert_eq!(a.detected, b.detected);
+        assert!((a.rate - b.rate).abs() < 1e-9 * b.rate, "{a:?} {b:?}");
+    }
+    // A detection without an id cannot be counted once: refused.
+    let anonymous = StepRequest {
+        sensors: sensors.clone(),
+        detections: vec![TargetIn {
+            id: None,
+            x: sensors[0].x,
+            y: sensors[0].y,
+            vx: 6.0,
+            vy: 0.0,
+        }],
+        ..StepRequest::default()
+    };
+    let e = session
+        .learner()
+        .unwrap()
+        .fold(&anonymous.sensors, &anonymous.detections)
+        .unwrap_err();
+    assert_eq!(e.field, "detections[0].id");
+}

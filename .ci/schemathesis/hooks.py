@@ -146,6 +146,14 @@ UNSCHEMATISABLE = [
         "a relation between items of an array (each step number is the previous one plus one)",
     ),
     (
+        r"^learn_rates: a learning session precomputes its scenario again",
+        "a bound on the predicted precompute time of the scenario named or sent in the body (src/cost.rs)",
+    ),
+    (
+        r"^detections\[\d+\](\.id: required when the session learns rates|: \(.*\) lies outside every field of view|\.id: track id .* (jumps|is detected twice))",
+        "a learning session's detections: an id (required only when the session, created earlier, learns), in a field of view of the step's sensors, moving no faster than a target",
+    ),
+    (
         r"^detections: the session would follow \d+ targets",
         "a bound on the session's tracks: this step's detections plus those kept from earlier steps",
     ),

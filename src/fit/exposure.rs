@@ -80,11 +80,30 @@ impl<'a> WindowLooks<'a> {
         let classes = s.classes_of(j);
         let grid = RayGrid::of(s, j);
         // Looks bucketed by the rays that may cross them (compressed rows).
-        let spans: Vec<(usize, usize)> = self
+        let mut spans: Vec<(usize, usize)> = self
             .looks
             .iter()
             .map(|(_, l, _)| grid.span(s, j, l))
             .collect();
+        if fresh_from > 0 {
+            // Only the rays that a fresh look may cross can hold a target
+            // it detects: the older looks matter on those rays only.
+            let (lo, hi) = self
+                .looks
+                .iter()
+                .zip(&spans)
+                .filter(|((t, _, _), _)| *t >= fresh_from)
+                .fold((usize::MAX, 0), |(lo, hi), (_, &(a, b))| {
+                    if b > a {
+                        (lo.min(a), hi.max(b))
+                    } else {
+                        (lo, hi)
+                    }
+                });
+            for span in &mut spans {
+                *span = (span.0.max(lo), span.1.min(hi));
+            }
+        }
         let mut starts = vec![0usize; grid.n + 1];
         for &(lo, hi) in &spans {
             for i in lo..hi {
@@ -108,7 +127,10 @@ impl<'a> WindowLooks<'a> {
             .into_par_iter()
             .map_init(RayScratch::default, |sc, i| {
                 let looks = &bucket[starts[i]..starts[i + 1]];
-                if looks.is_empty() {
+                if !looks
+                    .iter()
+                    .any(|&li| self.looks[li as usize].0 >= fresh_from)
+                {
                     return 0.0;
                 }
                 let d = src.direction(grid.angle(i));

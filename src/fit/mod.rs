@@ -8,12 +8,14 @@
 //! posterior follows ([`posterior`]). See `docs/learning.md`.
 
 pub mod exposure;
+pub mod learner;
 pub mod posterior;
 pub mod traceback;
 pub mod window;
 pub mod wire;
 
 pub use exposure::WindowLooks;
+pub use learner::{LearntStep, RateLearner};
 pub use posterior::{Posterior, Prior};
 pub use traceback::Tolerance;
 pub use window::{FirstDetection, FitWindow, Observed, Tolerances, TrackBook};

@@ -104,15 +104,21 @@ impl TrackBook {
         detections: &[DetectionIn],
         tol: &Tolerances,
     ) -> Result<Observed, ValidationError> {
+        // `steps[3].sensors`, or `sensors` for a session's step.
+        let field = if field.is_empty() {
+            String::new()
+        } else {
+            format!("{field}.")
+        };
         if sensors.len() > MAX_SENSORS {
             return Err(ValidationError::new(
-                format!("{field}.sensors"),
+                format!("{field}sensors"),
                 format!("at most {MAX_SENSORS} sensors, got {}", sensors.len()),
             ));
         }
         if detections.len() > MAX_FIT_DETECTIONS {
             return Err(ValidationError::new(
-                format!("{field}.detections"),
+                format!("{field}detections"),
                 format!(
                     "at most {MAX_FIT_DETECTIONS} detections, got {}",
                     detections.len()
@@ -124,11 +130,11 @@ impl TrackBook {
         for (i, sensor) in sensors.iter().enumerate() {
             if !ids.insert(sensor.id.key()) {
                 return Err(ValidationError::new(
-                    format!("{field}.sensors[{i}].id"),
+                    format!("{field}sensors[{i}].id"),
                     "duplicate sensor id",
                 ));
             }
-            let name = || format!("{field}.sensors[{i}]");
+            let name = || format!("{field}sensors[{i}]");
             let (cell, ty) = place(s, &name, sensor.x, sensor.y, sensor.sensor_type.as_deref())?;
             looks.push(s.look(ty, cell));
         }
@@ -145,7 +151,7 @@ impl TrackBook {
         let mut updates = Vec::new();
         let mut firsts = Vec::new();
         for (i, d) in detections.iter().enumerate() {
-            let name = || format!("{field}.detections[{i}]");
+            let name = || format!("{field}detections[{i}]");
             for (axis, v) in [("x", d.x), ("y", d.y), ("vx", d.vx), ("vy", d.vy)] {
                 if !v.is_finite() {
                     return Err(ValidationError::new(

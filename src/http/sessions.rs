@@ -20,6 +20,8 @@ use super::extract::{Json, Path, QueuedJson};
 use super::middleware::RequestStart;
 use super::planning::{plan_admitted, resolve_scenario};
 use super::state::AppState;
+use crate::catalog::predicted_precompute_ms;
+use crate::fit::SourceRate;
 use crate::limits::{MAX_HORIZON, MAX_MIN_SEPARATION, MAX_TARGETS};
 use crate::planner::{PlanResponse, check_estimator};
 use crate::scenario::ValidationError;
@@ -45,6 +47,9 @@ pub struct SessionInfo {
     /// Approximate memory it holds, bytes (the scenario's statistics,
     /// shared, aside).
     pub memory_bytes: usize,
+    /// With `learn_rates`: each source's rate learnt so far.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rates: Option<Vec<SourceRate>>,
 }
 
 impl SessionInfo {
@@ -58,6 +63,7 @@ impl SessionInfo {
             settings: s.settings().clone(),
             tracks: s.tracks().to_vec(),
             memory_bytes: s.memory_bytes(),
+            rates: s.learner().map(|l| l.rates()),
         }
     }
 }
@@ -70,6 +76,11 @@ pub struct StepResponse {
     /// The plan, as `POST /v1/scenarios/{id}/plan` gives it.
     #[serde(flatten)]
     pub plan: PlanResponse,
+    /// With `learn_rates`: each source's rate learnt up to this step, as
+    /// `POST /v1/scenarios/{id}/fit` gives them (the plan used the
+    /// posterior means).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rates: Option<Vec<SourceRate>>,
 }
 
 /// `POST /v1/sessions` → 201 [`SessionInfo`] with `Location`.
@@ -86,7 +97,11 @@ pub struct StepResponse {
         `history_steps` (0..=32, 16 by default) is how many steps of history it keeps. \
         Sessions live in this replica's memory: route a session's requests to the replica \
         that created it, or use the stateless endpoints. A session idle for `--session-ttl-s` \
-        (600 s), or the least recently used past `--max-sessions` (10 000), is dropped.",
+        (600 s), or the least recently used past `--max-sessions` (10 000), is dropped. \
+        With `learn_rates: true` the session learns the sources' rates from its detections \
+        (each needs an `id`), plans with them and reports them as `rates` at every step \
+        (see `docs/learning.md`); only a scenario precomputed within \
+        `--sync-precompute-ms` may learn.",
     request_body(content = doc::CreateSessionRequest, description = "Scenario and defaults.",
         example = json!(examples::session_request())),
     responses(
@@ -127,6 +142,22 @@ pub async fn create(
         settings.estimator.unwrap_or_default(),
         &planner.scenario,
     )?;
+    settings.tolerances(&planner.scenario)?;
+    if settings.learn_rates == Some(true) {
+        // A learning session precomputes its scenario again as its rates
+        // move: only a scenario precomputed at once may learn.
+        let predicted_ms = predicted_precompute_ms(&planner.scenario);
+        let budget_ms = state.registry.limits().sync_precompute_ms;
+        if predicted_ms > budget_ms {
+            return Err(ValidationError::new(
+                "learn_rates",
+                format!(
+                    "a learning session precomputes its scenario again as its rates move; this one is predicted to take {predicted_ms:.0} ms, above this server's synchronous budget of {budget_ms:.0} ms (--sync-precompute-ms)"
+                ),
+            )
+            .into());
+        }
+    }
     let session = Session::new(planner, settings);
     let (id, shared) = state.sessions.insert(session);
     let info = SessionInfo::of(id.clone(), &*shared.lock().await);
@@ -188,10 +219,26 @@ pub async fn step(
         )
         .into());
     }
-    let plan = plan_admitted(&state, start, session.planner().clone(), &prepared.request).await?;
+    // Learning folds this step in first (off the async workers), so the
+    // plan uses the rates that include it.
+    let learnt = match session.learner() {
+        Some(learner) => {
+            let learner = learner.clone();
+            let (sensors, detections) = (req.sensors.clone(), req.detections.clone());
+            Some(super::queue::on_rayon(move || learner.fold(&sensors, &detections)).await??)
+        }
+        None => None,
+    };
+    let planner = session.planner_for(learnt.as_ref());
+    let plan = plan_admitted(&state, start, planner, &prepared.request).await?;
     let step = session.step();
     session.commit(prepared);
-    Ok(Json(StepResponse { step, plan }))
+    let rates = learnt.map(|learnt| {
+        let rates = learnt.rates().to_vec();
+        session.commit_learnt(learnt);
+        rates
+    });
+    Ok(Json(StepResponse { step, plan, rates }))
 }
 
 /// `GET /v1/sessions/{id}` → 200 [`SessionInfo`].

@@ -186,3 +186,66 @@ async fn a_long_window_fits_past_the_plan_body_limit() {
     }
     assert!(exposed > 0, "{body}");
 }
+
+#[tokio::test]
+async fn a_learning_session_reports_its_rates_every_step() {
+    let app = spawn_app().await;
+    let created = json_body(
+        app.post_json(
+            "/v1/sessions",
+            &json!({"scenario_id": "paper-v10", "learn_rates": true}),
+        )
+        .await,
+        StatusCode::CREATED,
+    )
+    .await;
+    let id = created["id"].as_str().unwrap();
+    assert_eq!(created["settings"]["learn_rates"], true);
+    assert_eq!(created["rates"].as_array().unwrap().len(), 8);
+    let url = format!("/v1/sessions/{id}/step");
+    let window = fit_request();
+    let mut last = Value::Null;
+    for step in window["steps"].as_array().unwrap() {
+        last = json_body(app.post_json(&url, step).await, StatusCode::OK).await;
+    }
+    let rates = last["rates"].as_array().unwrap();
+    assert_eq!(rates.len(), 8);
+    // The same as a fit of the same window: target 17 counts once.
+    let fitted = json_body(
+        app.post_json("/v1/scenarios/paper-v10/fit", &window).await,
+        StatusCode::OK,
+    )
+    .await;
+    for (a, b) in rates.iter().zip(fitted["sources"].as_array().unwrap()) {
+        assert_eq!(a["detected"], b["detected"]);
+        let (x, y) = (a["rate"].as_f64().unwrap(), b["rate"].as_f64().unwrap());
+        assert!((x - y).abs() < 1e-9 * y, "{a} {b}");
+    }
+    // Each detection needs its track id; the refused step changes nothing.
+    let mut anonymous = window["steps"][1].clone();
+    anonymous["detections"][0]
+        .as_object_mut()
+        .unwrap()
+        .remove("id");
+    assert_validation(app.post_json(&url, &anonymous).await, "detections[0].id").await;
+    let info = json_body(app.get(&format!("/v1/sessions/{id}")).await, StatusCode::OK).await;
+    assert_eq!(info["step"], 2);
+    assert_eq!(info["rates"], last["rates"]);
+    // Without learn_rates, no rates.
+    let plain = json_body(
+        app.post_json("/v1/sessions", &json!({"scenario_id": "paper-v10"}))
+            .await,
+        StatusCode::CREATED,
+    )
+    .await;
+    let step = json_body(
+        app.post_json(
+            &format!("/v1/sessions/{}/step", plain["id"].as_str().unwrap()),
+            &window["steps"][0],
+        )
+        .await,
+        StatusCode::OK,
+    )
+    .await;
+    assert!(step.get("rates").is_none() && plain.get("rates").is_none());
+}

@@ -6,9 +6,13 @@ from typing import Any, TypeVar, TYPE_CHECKING
 from attrs import define as _attrs_define
 from attrs import field as _attrs_field
 
+from ..types import UNSET, Unset
+
+from typing import cast
 
 if TYPE_CHECKING:
     from ..models.session_settings import SessionSettings
+    from ..models.source_rate import SourceRate
     from ..models.track import Track
 
 
@@ -30,6 +34,7 @@ class SessionInfo:
             `history_steps`.
         step (int): Steps made so far: the number of the next step.
         tracks (list[Track]): The targets it follows after the last step.
+        rates (list[SourceRate] | None | Unset): With `learn_rates`: each source's rate learnt so far.
     """
 
     history_held: int
@@ -40,6 +45,7 @@ class SessionInfo:
     settings: SessionSettings
     step: int
     tracks: list[Track]
+    rates: list[SourceRate] | None | Unset = UNSET
     additional_properties: dict[str, Any] = _attrs_field(init=False, factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
@@ -62,6 +68,18 @@ class SessionInfo:
             tracks_item = tracks_item_data.to_dict()
             tracks.append(tracks_item)
 
+        rates: list[dict[str, Any]] | None | Unset
+        if isinstance(self.rates, Unset):
+            rates = UNSET
+        elif isinstance(self.rates, list):
+            rates = []
+            for rates_type_0_item_data in self.rates:
+                rates_type_0_item = rates_type_0_item_data.to_dict()
+                rates.append(rates_type_0_item)
+
+        else:
+            rates = self.rates
+
         field_dict: dict[str, Any] = {}
         field_dict.update(self.additional_properties)
         field_dict.update(
@@ -76,12 +94,15 @@ class SessionInfo:
                 "tracks": tracks,
             }
         )
+        if rates is not UNSET:
+            field_dict["rates"] = rates
 
         return field_dict
 
     @classmethod
     def from_dict(cls: type[T], src_dict: Mapping[str, Any]) -> T:
         from ..models.session_settings import SessionSettings  # noqa: PLC0415
+        from ..models.source_rate import SourceRate  # noqa: PLC0415
         from ..models.track import Track  # noqa: PLC0415
 
         d = dict(src_dict)
@@ -106,6 +127,28 @@ class SessionInfo:
 
             tracks.append(tracks_item)
 
+        def _parse_rates(data: object) -> list[SourceRate] | None | Unset:
+            if data is None:
+                return data
+            if isinstance(data, Unset):
+                return data
+            try:
+                if not isinstance(data, list):
+                    raise TypeError()
+                rates_type_0 = []
+                _rates_type_0 = data
+                for rates_type_0_item_data in _rates_type_0:
+                    rates_type_0_item = SourceRate.from_dict(rates_type_0_item_data)
+
+                    rates_type_0.append(rates_type_0_item)
+
+                return rates_type_0
+            except (TypeError, ValueError, AttributeError, KeyError):
+                pass
+            return cast(list[SourceRate] | None | Unset, data)
+
+        rates = _parse_rates(d.pop("rates", UNSET))
+
         session_info = cls(
             history_held=history_held,
             history_steps=history_steps,
@@ -115,6 +158,7 @@ class SessionInfo:
             settings=settings,
             step=step,
             tracks=tracks,
+            rates=rates,
         )
 
         session_info.additional_properties = d

@@ -17,6 +17,7 @@ if TYPE_CHECKING:
     from ..models.bound import Bound
     from ..models.joint_report import JointReport
     from ..models.plan_out import PlanOut
+    from ..models.source_rate import SourceRate
 
 
 T = TypeVar("T", bound="StepResponse")
@@ -46,6 +47,9 @@ class StepResponse:
         step (int): The number of this step (0 for the first).
         bound (Bound | None | Unset):
         joint (JointReport | None | Unset):
+        rates (list[SourceRate] | None | Unset): With `learn_rates`: each source's rate learnt up to this step, as
+            `POST /v1/scenarios/{id}/fit` gives them (the plan used the
+            posterior means).
     """
 
     compute_micros: int
@@ -62,6 +66,7 @@ class StepResponse:
     step: int
     bound: Bound | None | Unset = UNSET
     joint: JointReport | None | Unset = UNSET
+    rates: list[SourceRate] | None | Unset = UNSET
     additional_properties: dict[str, Any] = _attrs_field(init=False, factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
@@ -111,6 +116,18 @@ class StepResponse:
         else:
             joint = self.joint
 
+        rates: list[dict[str, Any]] | None | Unset
+        if isinstance(self.rates, Unset):
+            rates = UNSET
+        elif isinstance(self.rates, list):
+            rates = []
+            for rates_type_0_item_data in self.rates:
+                rates_type_0_item = rates_type_0_item_data.to_dict()
+                rates.append(rates_type_0_item)
+
+        else:
+            rates = self.rates
+
         field_dict: dict[str, Any] = {}
         field_dict.update(self.additional_properties)
         field_dict.update(
@@ -133,6 +150,8 @@ class StepResponse:
             field_dict["bound"] = bound
         if joint is not UNSET:
             field_dict["joint"] = joint
+        if rates is not UNSET:
+            field_dict["rates"] = rates
 
         return field_dict
 
@@ -141,6 +160,7 @@ class StepResponse:
         from ..models.bound import Bound  # noqa: PLC0415
         from ..models.joint_report import JointReport  # noqa: PLC0415
         from ..models.plan_out import PlanOut  # noqa: PLC0415
+        from ..models.source_rate import SourceRate  # noqa: PLC0415
 
         d = dict(src_dict)
         compute_micros = d.pop("compute_micros")
@@ -206,6 +226,28 @@ class StepResponse:
 
         joint = _parse_joint(d.pop("joint", UNSET))
 
+        def _parse_rates(data: object) -> list[SourceRate] | None | Unset:
+            if data is None:
+                return data
+            if isinstance(data, Unset):
+                return data
+            try:
+                if not isinstance(data, list):
+                    raise TypeError()
+                rates_type_0 = []
+                _rates_type_0 = data
+                for rates_type_0_item_data in _rates_type_0:
+                    rates_type_0_item = SourceRate.from_dict(rates_type_0_item_data)
+
+                    rates_type_0.append(rates_type_0_item)
+
+                return rates_type_0
+            except (TypeError, ValueError, AttributeError, KeyError):
+                pass
+            return cast(list[SourceRate] | None | Unset, data)
+
+        rates = _parse_rates(d.pop("rates", UNSET))
+
         step_response = cls(
             compute_micros=compute_micros,
             coordination=coordination,
@@ -221,6 +263,7 @@ class StepResponse:
             step=step,
             bound=bound,
             joint=joint,
+            rates=rates,
         )
 
         step_response.additional_properties = d

@@ -108,7 +108,10 @@ def sync_detailed(
     of its steps; `history_steps` (0..=32, 16 by default) is how many steps of history it keeps.
     Sessions live in this replica's memory: route a session's requests to the replica that created it,
     or use the stateless endpoints. A session idle for `--session-ttl-s` (600 s), or the least recently
-    used past `--max-sessions` (10 000), is dropped.
+    used past `--max-sessions` (10 000), is dropped. With `learn_rates: true` the session learns the
+    sources' rates from its detections (each needs an `id`), plans with them and reports them as `rates`
+    at every step (see `docs/learning.md`); only a scenario precomputed within `--sync-precompute-ms`
+    may learn.
 
     Args:
         body (SessionRequestById | SessionRequestWithScenario): Body of `POST /v1/sessions`:
@@ -147,7 +150,10 @@ def sync(
     of its steps; `history_steps` (0..=32, 16 by default) is how many steps of history it keeps.
     Sessions live in this replica's memory: route a session's requests to the replica that created it,
     or use the stateless endpoints. A session idle for `--session-ttl-s` (600 s), or the least recently
-    used past `--max-sessions` (10 000), is dropped.
+    used past `--max-sessions` (10 000), is dropped. With `learn_rates: true` the session learns the
+    sources' rates from its detections (each needs an `id`), plans with them and reports them as `rates`
+    at every step (see `docs/learning.md`); only a scenario precomputed within `--sync-precompute-ms`
+    may learn.
 
     Args:
         body (SessionRequestById | SessionRequestWithScenario): Body of `POST /v1/sessions`:
@@ -181,7 +187,10 @@ async def asyncio_detailed(
     of its steps; `history_steps` (0..=32, 16 by default) is how many steps of history it keeps.
     Sessions live in this replica's memory: route a session's requests to the replica that created it,
     or use the stateless endpoints. A session idle for `--session-ttl-s` (600 s), or the least recently
-    used past `--max-sessions` (10 000), is dropped.
+    used past `--max-sessions` (10 000), is dropped. With `learn_rates: true` the session learns the
+    sources' rates from its detections (each needs an `id`), plans with them and reports them as `rates`
+    at every step (see `docs/learning.md`); only a scenario precomputed within `--sync-precompute-ms`
+    may learn.
 
     Args:
         body (SessionRequestById | SessionRequestWithScenario): Body of `POST /v1/sessions`:
@@ -218,7 +227,10 @@ async def asyncio(
     of its steps; `history_steps` (0..=32, 16 by default) is how many steps of history it keeps.
     Sessions live in this replica's memory: route a session's requests to the replica that created it,
     or use the stateless endpoints. A session idle for `--session-ttl-s` (600 s), or the least recently
-    used past `--max-sessions` (10 000), is dropped.
+    used past `--max-sessions` (10 000), is dropped. With `learn_rates: true` the session learns the
+    sources' rates from its detections (each needs an `id`), plans with them and reports them as `rates`
+    at every step (see `docs/learning.md`); only a scenario precomputed within `--sync-precompute-ms`
+    may learn.
 
     Args:
         body (SessionRequestById | SessionRequestWithScenario): Body of `POST /v1/sessions`:

@@ -1,0 +1,208 @@
+//! A session's running fit of its source rates: the sufficient statistics
+//! of its whole life, folded in one step at a time.
+//!
+//! The exposure of a session's life is the sum over its steps `t` of the
+//! exposure of the targets that a look of step `t` detects and no earlier
+//! look does ([`WindowLooks::exposure`] with `fresh_from`). A target seen
+//! at step `t` can only have been seen before while it was in the zone, so
+//! only the looks of the last [`RateLearner::memory`] steps (the longest
+//! time a target can stay in the zone) take part. Each track id counts once
+//! for the session's life, through a [`TrackBook`].
+
+use std::collections::VecDeque;
+use std::sync::Arc;
+
+use super::exposure::WindowLooks;
+use super::posterior::Prior;
+use super::window::{Observed, Tolerances, TrackBook};
+use super::wire::{DetectionIn, SourceRate};
+use super::{Attribution, Unexplained};
+use crate::limits::{LEARN_REPLAN_DRIFT, MAX_LEARN_MEMORY_STEPS, MAX_SESSION_TRACKS};
+use crate::planner::{Planner, SensorIn, TargetIn};
+use crate::scenario::{Look, Scenario, ValidationError};
+
+/// A session's learnt rates and the planner at those rates.
+#[derive(Debug, Clone)]
+pub struct RateLearner {
+    /// The scenario as registered (its rates are the prior's centre).
+    base: Arc<Planner>,
+    /// The planner plans are made with: `base` until the learnt rates
+    /// drift from its rates, then a planner at the learnt rates.
+    planner: Arc<Planner>,
+    memory: usize,
+    /// The looks of the last `memory` steps, oldest first.
+    recent: VecDeque<Vec<Look>>,
+    book: TrackBook,
+    exposure: Vec<f64>,
+    attribution: Attribution,
+    step: u64,
+    tolerances: Tolerances,
+}
+
+/// A step folded into a learner, not yet recorded ([`RateLearner::commit`]).
+#[derive(Debug)]
+pub struct LearntStep {
+    observed: Observed,
+    exposure: Vec<f64>,
+    attribution: Attribution,
+    rates: Vec<SourceRate>,
+    planner: Option<Arc<Planner>>,
+}
+
+impl LearntStep {
+    /// The rates after this step.
+    pub fn rates(&self) -> &[SourceRate] {
+        &self.rates
+    }
+
+    /// The planner at this step's rates, when they drifted from the
+    /// learner's.
+    pub fn planner(&self) -> Option<&Arc<Planner>> {
+        self.planner.as_ref()
+    }
+}
+
+impl RateLearner {
+    /// A learner with nothing observed: the scenario prior, and `base`'s
+    /// planner.
+    pub fn new(base: Arc<Planner>, tolerances: Tolerances) -> Self {
+        let s = &base.scenario;
+        let slowest = s.min_speed();
+        let diagonal = s.width.hypot(s.height);
+        let memory = ((diagonal / slowest).ceil() as usize + 1).min(MAX_LEARN_MEMORY_STEPS);
+        RateLearner {
+            planner: base.clone(),
+            memory,
+            recent: VecDeque::new(),
+            book: TrackBook::new(MAX_SESSION_TRACKS),
+            exposure: vec![0.0; s.sources.len()],
+            attribution: Attribution::new(s),
+            step: 0,
+            tolerances,
+            base,
+        }
+    }
+
+    /// Steps of looks kept: the longest a target can stay in the zone.
+    pub fn memory(&self) -> usize {
+        self.memory
+    }
+
+    /// The planner to plan with.
+    pub fn planner(&self) -> &Arc<Planner> {
+        &self.planner
+    }
+
+    /// The rates now.
+    pub fn rates(&self) -> Vec<SourceRate> {
+        self.attribution
+            .rates(&self.base.scenario, &self.exposure, Prior::Scenario)
+    }
+
+    /// Targets no source explains, so far.
+    pub fn unexplained(&self) -> &[Unexplained] {
+        &self.attribution.unexplained
+    }
+
+    /// Approximate heap memory held, bytes (the planners aside).
+    pub fn memory_bytes(&self) -> usize {
+        let looks: usize = self.recent.iter().map(|l| l.capacity()).sum();
+        looks * std::mem::size_of::<Look>()
+            + self.book.len() * 64
+            + self.attribution.shared.len() * 48
+            + self.attribution.unexplained.len() * 64
+    }
+
+    /// Folds this step's looks and detections in, without changing the
+    /// learner: validates them (every detection needs an `id`, lies in a
+    /// look, and moves no faster than a target flies), counts the
+    /// exposure it adds and its new targets, and builds a planner at the
+    /// new rates when they drifted more than [`LEARN_REPLAN_DRIFT`] from
+    /// the planner's. Field names are those of a step request
+    /// (`sensors[i]`, `detections[i]`).
+    pub fn fold(
+        &self,
+        sensors: &[SensorIn],
+        detections: &[TargetIn],
+    ) -> Result<LearntStep, ValidationError> {
+        let s = &self.base.scenario;
+        let detections = detections
+            .iter()
+            .enumerate()
+            .map(|(i, d)| {
+                let id = d.id.clone().ok_or_else(|| {
+                    ValidationError::new(
+                        format!("detections[{i}].id"),
+                        "required when the session learns rates: each target counts once",
+                    )
+                })?;
+                Ok(DetectionIn {
+                    id,
+                    x: d.x,
+                    y: d.y,
+                    vx: d.vx,
+                    vy: d.vy,
+                })
+            })
+            .collect::<Result<Vec<_>, ValidationError>>()?;
+        let observed =
+            self.book
+                .observe(s, "", self.step, sensors, &detections, &self.tolerances)?;
+        let mut window: Vec<Vec<Look>> = self.recent.iter().cloned().collect();
+        window.push(observed.looks.clone());
+        let fresh = window.len() - 1;
+        let added = WindowLooks::new(s, &window).exposure(fresh);
+        let exposure: Vec<f64> = self
+            .exposure
+            .iter()
+            .zip(&added)
+            .map(|(a, b)| a + b)
+            .collect();
+        let mut attribution = self.attribution.clone();
+        attribution.add(s, &observed.firsts, &self.tolerances.traceback);
+        let rates = attribution.rates(s, &exposure, Prior::Scenario);
+        let planner = self.replan(&rates);
+        Ok(LearntStep {
+            observed,
+            exposure,
+            attribution,
+            rates,
+            planner,
+        })
+    }
+
+    /// A planner at `rates` when they drifted from the planner's, if the
+    /// scenario at those rates is valid.
+    fn replan(&self, rates: &[SourceRate]) -> Option<Arc<Planner>> {
+        let planned = &self.planner.scenario.sources;
+        let mean = planned.iter().map(|s| s.rate).sum::<f64>() / planned.len() as f64;
+        let drifted = rates.iter().zip(planned).any(|(r, p)| {
+            (r.rate - p.rate).abs() > LEARN_REPLAN_DRIFT * p.rate.max(mean).max(f64::MIN_POSITIVE)
+        });
+        if !drifted {
+            return None;
+        }
+        let mut spec = self.base.scenario.spec.clone();
+        for (src, r) in spec.sources.iter_mut().zip(rates) {
+            src.rate = r.rate;
+        }
+        let scenario = Scenario::new(spec).ok()?;
+        Some(Arc::new(Planner::new(scenario)))
+    }
+
+    /// Records a step that [`RateLearner::fold`] gave.
+    pub fn commit(&mut self, mut step: LearntStep) {
+        self.book.commit(&mut step.observed);
+        self.recent
+            .push_back(std::mem::take(&mut step.observed.looks));
+        while self.recent.len() > self.memory {
+            self.recent.pop_front();
+        }
+        self.exposure = step.exposure;
+        self.attribution = step.attribution;
+        if let Some(planner) = step.planner {
+            self.planner = planner;
+        }
+        self.step += 1;
+    }
+}
