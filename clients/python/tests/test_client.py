@@ -141,6 +141,20 @@ def test_fit_learns_the_rates_of_a_window(vigil: Vigil) -> None:
     assert "steps[0].detections[0]" in outside.value.detail
 
 
+def test_a_learning_session_reports_its_rates(vigil: Vigil) -> None:
+    step = lambda x: {  # noqa: E731
+        "sensors": [{"id": "a", "x": x - 5.0, "y": 95.0}],
+        "detections": [{"id": 17, "x": x, "y": 100.0, "vx": 10.0, "vy": 0.0}],
+    }
+    with vigil.session("paper-v10", learn_rates=True) as session:
+        session.step(step(60.0))
+        response = session.step(step(70.0))
+    assert len(response.rates) == 8
+    # Target 17 counts once, for the source at (-1, 100).
+    assert response.rates[0].detected == 1.0
+    assert sum(r.detected for r in response.rates) == 1.0
+
+
 def test_a_session_steps_and_is_deleted_at_the_end(vigil: Vigil) -> None:
     with vigil.session("paper-v10", horizon=2, history_steps=4) as session:
         assert session.info.step == 0

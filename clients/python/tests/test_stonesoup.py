@@ -158,6 +158,27 @@ def test_tracks_and_looks_reach_the_plan_request(vigil, paper):
     assert request["targets"][0]["y"] == pytest.approx(75.0)
 
 
+def test_a_learning_manager_reports_the_rates_it_learns(vigil, paper):
+    from stonesoup.types.state import GaussianState
+    from stonesoup.types.track import Track
+
+    vmap = VigilMap(paper)
+    p = make_platform("p1", (55, 95), T0, vmap)
+    with pytest.raises(ValueError, match="use_session"):
+        VigilSensorManager(vigil=vigil, scenario_id="paper-v10", platforms={p}, learn_rates=True)
+    manager = VigilSensorManager(vigil=vigil, scenario_id="paper-v10", platforms={p},
+                                 use_session=True, learn_rates=True)
+    # A track flying east along y = 100, from the source at (-1, 100).
+    track = Track([GaussianState([60.0, 10.0, 100.0, 0.0], np.eye(4), timestamp=T0)], id="k")
+    try:
+        manager.choose_actions({track}, T0 + STEP)
+    finally:
+        manager.close()
+    rates = manager.last_response.rates
+    assert len(rates) == 8
+    assert rates[0].detected == 1.0 and rates[0].exposure > 0
+
+
 @pytest.mark.parametrize("scenario", ["paper-v10", "site-gates"])
 def test_the_stationary_population_is_the_models(vigil, scenario):
     """The first step's count, over independent seeds, has the mean of the

@@ -870,6 +870,17 @@ class VigilSensorManager(SensorManager):
         "min_separation, gap_target, budget_ms.",
     )
     use_session: bool = Property(default=False, doc="Step a Vigil session instead of planning.")
+    learn_rates: bool = Property(
+        default=False,
+        doc="With use_session: the session learns the sources' rates from the tracks "
+        "updated each step (each track id counts once) and plans with them; "
+        "``last_response.rates`` has them. A tracker's noise needs ``learn_tolerance``.",
+    )
+    learn_tolerance: Mapping[str, float] = Property(
+        default=None,
+        doc="With learn_rates: the session's ``tolerance`` (``traceback``, ``speed``, "
+        "``look``; see Vigil's docs/learning.md). Exact data by default.",
+    )
     track_position_mapping: tuple = Property(default=(0, 2), doc="x, y in track states.")
     track_velocity_mapping: tuple = Property(default=(1, 3), doc="vx, vy in track states.")
 
@@ -893,6 +904,8 @@ class VigilSensorManager(SensorManager):
                 raise ValueError(f"sensor_types[{pid!r}]: {e.args[0]}") from None
         if not 0 <= self.history_steps <= 32:
             raise ValueError(f"history_steps must be in 0..=32, got {self.history_steps}")
+        if self.learn_rates and not self.use_session:
+            raise ValueError("learn_rates needs use_session=True: a session keeps what it learns")
         self._looks: deque[tuple[datetime.datetime, list[dict]]] = deque()
         self._session = None
         self.last_response = None
@@ -1033,6 +1046,10 @@ class VigilSensorManager(SensorManager):
                 settings = {k: v for k, v in (self.plan_options or {}).items()
                             if k in ("horizon", "estimator", "objective", "coordination",
                                      "min_separation", "observed")}
+                if self.learn_rates:
+                    settings["learn_rates"] = True
+                    if self.learn_tolerance:
+                        settings["tolerance"] = dict(self.learn_tolerance)
                 self._session = self.client.session(
                     scenario_id=self.scenario_id, history_steps=self.history_steps, **settings
                 )
