@@ -544,6 +544,8 @@ impl Sim {
             min_separation: self.min_separation.map(Into::into),
             history_steps: Some(history.into()),
             certify: None,
+            learn_rates: None,
+            tolerance: None,
         }
     }
 
