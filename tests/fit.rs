@@ -262,15 +262,16 @@ fn exposure_counted_step_by_step_adds_up() {
     }
 }
 
-/// The share of worlds whose 95% interval holds each source's true rate.
-fn coverage(obstacles: bool, scales: &[f64], prior: Prior, worlds: u64) -> Vec<f64> {
+/// Per source, the share of worlds whose 95% interval holds its true
+/// rate, and the largest upper end of its interval.
+fn coverage(obstacles: bool, scales: &[f64], prior: Prior, worlds: u64) -> Vec<(f64, f64)> {
     let spec = yard(obstacles);
     let s = scenario(spec.clone());
     let world_s = scenario(scaled(spec, scales));
     let planner = Arc::new(Planner::new(s.clone()));
     let looks = driven(&planner, &world_s, 150, 11);
     let exposure = WindowLooks::new(&s, &looks_of(&s, &looks)).exposure(0);
-    let held: Vec<Vec<bool>> = (0..worlds)
+    let held: Vec<Vec<(bool, f64)>> = (0..worlds)
         .into_par_iter()
         .map(|seed| {
             let (req, _) = observe(&world_s, &looks, 5000 + seed);
@@ -282,13 +283,18 @@ fn coverage(obstacles: bool, scales: &[f64], prior: Prior, worlds: u64) -> Vec<f
                 .iter()
                 .map(|r| {
                     let [lo, hi] = r.interval.unwrap();
-                    (lo..=hi).contains(&world_s.sources[r.index].rate)
+                    ((lo..=hi).contains(&world_s.sources[r.index].rate), hi)
                 })
                 .collect()
         })
         .collect();
     (0..scales.len())
-        .map(|j| held.iter().filter(|h| h[j]).count() as f64 / worlds as f64)
+        .map(|j| {
+            (
+                held.iter().filter(|h| h[j].0).count() as f64 / worlds as f64,
+                held.iter().map(|h| h[j].1).fold(0.0, f64::max),
+            )
+        })
         .collect()
 }
 
@@ -313,26 +319,27 @@ fn intervals_cover_the_true_rates() {
     let scales = [3.0, 1.0 / 3.0, 1.0, 0.0];
     let worlds = 300;
     for obstacles in [false, true] {
-        let flat = coverage(obstacles, &scales, Prior::Flat, worlds);
-        // Pooled over the sources that emit: 3 × worlds intervals.
-        let pooled = flat[..3].iter().sum::<f64>() / 3.0;
+        let spec_rate = scenario(yard(obstacles)).sources[3].rate;
         let se = (0.95 * 0.05 / (3.0 * worlds as f64)).sqrt();
-        assert!(
-            (pooled - 0.95).abs() < 4.0 * se,
-            "obstacles {obstacles}: flat prior covers {pooled:.3} (per source {flat:?}), not 0.95 ± {:.3}",
-            4.0 * se
-        );
-        // A silent source has no detection: its interval starts at 0.
-        assert_eq!(flat[3], 1.0);
-        // The scenario's prior (shape 1) is weak enough to cover as well.
-        let centred = coverage(obstacles, &scales, Prior::Scenario, worlds);
-        let pooled = centred[..3].iter().sum::<f64>() / 3.0;
-        assert!(
-            (pooled - 0.95).abs() < 4.0 * se,
-            "obstacles {obstacles}: the scenario prior covers {pooled:.3} (per source {centred:?})"
-        );
-        assert_eq!(centred[3], 1.0);
-        eprintln!("obstacles {obstacles}: coverage, flat {flat:?}, scenario {centred:?}");
+        for prior in [Prior::Flat, Prior::Scenario] {
+            let found = coverage(obstacles, &scales, prior, worlds);
+            // Pooled over the sources that emit: 3 × worlds intervals.
+            let pooled = found[..3].iter().map(|c| c.0).sum::<f64>() / 3.0;
+            assert!(
+                (pooled - 0.95).abs() < 4.0 * se,
+                "obstacles {obstacles}, {prior:?} prior: covers {pooled:.3} (per source {found:?}), not 0.95 ± {:.3}",
+                4.0 * se
+            );
+            // An equal-tailed interval never holds a silent source's 0,
+            // but its upper end learns that the source is quiet.
+            assert_eq!(found[3].0, 0.0);
+            assert!(
+                found[3].1 < spec_rate,
+                "obstacles {obstacles}, {prior:?} prior: the silent source's upper end reaches {}",
+                found[3].1
+            );
+            eprintln!("obstacles {obstacles}: coverage, {prior:?} prior: {found:?}");
+        }
     }
 }
 

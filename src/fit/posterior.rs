@@ -65,17 +65,12 @@ impl Posterior {
         (self.rate > 0.0).then(|| self.shape / self.rate)
     }
 
-    /// The 95% credible interval, if proper: equal-tailed (the 2.5% and
-    /// 97.5% quantiles), except when the density is highest at 0 (shape
-    /// ≤ 1: no detection yet), where it is `[0, 95% quantile]`, the
-    /// highest-density interval; an equal-tailed one would exclude a
-    /// silent source's rate, 0, every time.
+    /// The equal-tailed 95% credible interval (the 2.5% and 97.5%
+    /// quantiles), if proper. It never holds 0: for a source with no
+    /// detection its lower end is `−ln(0.975)/rate ≈ 0.0253/rate`.
     pub fn interval(&self) -> Option<[f64; 2]> {
         if self.rate <= 0.0 {
             return None;
-        }
-        if self.shape <= 1.0 {
-            return Some([0.0, self.quantile(0.95)]);
         }
         Some([self.quantile(0.025), self.quantile(0.975)])
     }

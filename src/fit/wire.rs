@@ -106,9 +106,8 @@ pub struct SourceRate {
     /// Targets per step: the posterior mean (the spec's rate when the
     /// posterior is improper: a flat prior that no look exposed).
     pub rate: f64,
-    /// The 95% credible interval `[lo, hi]`: equal-tailed, or `[0, 95%
-    /// quantile]` while the source has no detection; `null` when the
-    /// posterior is improper.
+    /// The equal-tailed 95% credible interval `[lo, hi]` (the posterior's
+    /// 2.5% and 97.5% quantiles); `null` when the posterior is improper.
     pub interval: Option<[f64; 2]>,
     /// Distinct targets detected from the source (fractional when a
     /// detection is shared between sources).

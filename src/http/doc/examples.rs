@@ -349,8 +349,8 @@ pub fn fit_response() -> Value {
         "scenario": "paper-v10",
         "steps": 2,
         "sources": [
-            {"index": 0, "rate": 0.081, "interval": [0.0084, 0.27], "detected": 1.0, "exposure": 12.3},
-            {"index": 1, "rate": 0.1, "interval": [0.0, 0.3], "detected": 0.0, "exposure": 0.0}
+            {"index": 0, "rate": 0.311, "interval": [0.0377, 0.867], "detected": 1.0, "exposure": 3.09},
+            {"index": 1, "rate": 0.191, "interval": [0.00483, 0.703], "detected": 0.0, "exposure": 1.91}
         ],
         "unexplained": []
     })

@@ -27,9 +27,8 @@ class SourceRate:
         index (int): The source's index in the scenario's `sources`.
         rate (float): Targets per step: the posterior mean (the spec's rate when the
             posterior is improper: a flat prior that no look exposed).
-        interval (list[float] | None | Unset): The 95% credible interval `[lo, hi]`: equal-tailed, or `[0, 95%
-            quantile]` while the source has no detection; `null` when the
-            posterior is improper.
+        interval (list[float] | None | Unset): The equal-tailed 95% credible interval `[lo, hi]` (the posterior's
+            2.5% and 97.5% quantiles); `null` when the posterior is improper.
     """
 
     detected: float
