@@ -298,7 +298,8 @@ impl Session {
                 .tolerances(&planner.scenario)
                 .or_else(|_| Tolerances::new(&planner.scenario, None))
                 .unwrap_or_else(|_| unreachable!("the default tolerances are valid"));
-            Arc::new(RateLearner::new(planner.clone(), tolerances))
+            let whole_zone = settings.observed == Some(Observed::Zone);
+            Arc::new(RateLearner::new(planner.clone(), tolerances, whole_zone))
         });
         Self {
             planner,

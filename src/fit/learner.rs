@@ -37,6 +37,9 @@ pub struct RateLearner {
     attribution: Attribution,
     step: u64,
     tolerances: Tolerances,
+    /// The detections cover the whole zone (a session's `observed:
+    /// zone`): each step's look is the zone, certain.
+    whole_zone: bool,
 }
 
 /// A step folded into a learner, not yet recorded ([`RateLearner::commit`]).
@@ -65,7 +68,9 @@ impl LearntStep {
 impl RateLearner {
     /// A learner with nothing observed: the scenario prior, and `base`'s
     /// planner.
-    pub fn new(base: Arc<Planner>, tolerances: Tolerances) -> Self {
+    /// With `whole_zone`, every step's detections are taken to cover the
+    /// zone (a session's `observed: zone`).
+    pub fn new(base: Arc<Planner>, tolerances: Tolerances, whole_zone: bool) -> Self {
         let s = &base.scenario;
         let slowest = s.min_speed();
         let diagonal = s.width.hypot(s.height);
@@ -79,6 +84,7 @@ impl RateLearner {
             attribution: Attribution::new(s),
             step: 0,
             tolerances,
+            whole_zone,
             base,
         }
     }
@@ -145,9 +151,15 @@ impl RateLearner {
                 })
             })
             .collect::<Result<Vec<_>, ValidationError>>()?;
-        let observed =
-            self.book
-                .observe(s, "", self.step, sensors, &detections, &self.tolerances)?;
+        let observed = self.book.observe(
+            s,
+            "",
+            self.step,
+            sensors,
+            &detections,
+            &self.tolerances,
+            self.whole_zone,
+        )?;
         let mut window: Vec<Vec<Look>> = self.recent.iter().cloned().collect();
         window.push(observed.looks.clone());
         let fresh = window.len() - 1;

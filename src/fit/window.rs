@@ -95,6 +95,9 @@ impl TrackBook {
     /// Validates step `step`'s sensors and detections (`field` names the
     /// step in errors, e.g. `steps[3]`) without changing the book, and
     /// returns its looks and an [`Observed`] step to [`TrackBook::commit`].
+    /// With `whole_zone` the detections cover the zone (a session's
+    /// `observed: zone`): the step's one look is the zone, certain.
+    #[allow(clippy::too_many_arguments)]
     pub fn observe(
         &self,
         s: &Scenario,
@@ -103,6 +106,7 @@ impl TrackBook {
         sensors: &[SensorIn],
         detections: &[DetectionIn],
         tol: &Tolerances,
+        whole_zone: bool,
     ) -> Result<Observed, ValidationError> {
         // `steps[3].sensors`, or `sensors` for a session's step.
         let field = if field.is_empty() {
@@ -145,7 +149,11 @@ impl TrackBook {
                 distinct.push(l);
             }
         }
-        let looks = distinct;
+        let looks = if whole_zone {
+            vec![Look::certain(s.zone_region())]
+        } else {
+            distinct
+        };
         let fastest = s.max_speed() * (1.0 + tol.traceback.speed);
         let mut seen = HashSet::new();
         let mut updates = Vec::new();
@@ -307,6 +315,7 @@ impl FitWindow {
                 &step.sensors,
                 &step.detections,
                 &tolerances,
+                false,
             )?;
             book.commit(&mut observed);
             looks.push(observed.looks);

@@ -249,3 +249,30 @@ async fn a_learning_session_reports_its_rates_every_step() {
     .await;
     assert!(step.get("rates").is_none() && plain.get("rates").is_none());
 }
+
+#[tokio::test]
+async fn a_learning_session_told_of_every_target_learns_from_the_zone() {
+    let app = spawn_app().await;
+    let created = json_body(
+        app.post_json(
+            "/v1/sessions",
+            &json!({"scenario_id": "paper-v10", "learn_rates": true, "observed": "zone"}),
+        )
+        .await,
+        StatusCode::CREATED,
+    )
+    .await;
+    let url = format!("/v1/sessions/{}/step", created["id"].as_str().unwrap());
+    // Far from the only sensor: with `observed: zone` the detections cover
+    // the zone, and so does the exposure.
+    let step = json!({"sensors": [{"id": "a", "x": 255, "y": 255}],
+                      "detections": [{"id": 5, "x": 60.0, "y": 100.0, "vx": 10.0, "vy": 0.0}]});
+    let body = json_body(app.post_json(&url, &step).await, StatusCode::OK).await;
+    let rates = body["rates"].as_array().unwrap();
+    assert_eq!(rates[0]["detected"], 1.0);
+    // Every source's targets in the zone are exposed at once.
+    assert!(
+        rates.iter().all(|r| r["exposure"].as_f64().unwrap() > 1.0),
+        "{body}"
+    );
+}
