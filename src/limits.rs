@@ -98,10 +98,6 @@ pub const MAX_FIT_DETECTIONS: usize = 20_000;
 /// steps with 64 sensors and 64 detections a step, written at full
 /// precision, fits with room to spare.
 pub const MAX_FIT_BODY_BYTES: usize = 32 * 1024 * 1024;
-/// Rays per π over which a fit integrates each source's exposure (the
-/// midpoint rule over takeoff angles): a fit is not on the planning loop's
-/// clock, so it takes the finest grid a spec may ask for.
-pub const FIT_RAYS_PER_PI: usize = MAX_RAYS_PER_PI;
 /// Shape of the Gamma prior that `"prior": "scenario"` puts on each
 /// source's rate, centred on the spec's rate: worth one target's detection.
 pub const RATE_PRIOR_SHAPE: f64 = 1.0;

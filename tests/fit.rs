@@ -572,3 +572,24 @@ fn a_learning_session_counts_what_a_window_fit_counts() {
         .unwrap_err();
     assert_eq!(e.field, "detections[0].id");
 }
+#[test]
+fn exposure_on_the_scenarios_rays_matches_a_fine_grid() {
+    for obstacles in [false, true] {
+        let s = scenario(yard(obstacles));
+        let planner = Arc::new(Planner::new(s.clone()));
+        let looks = looks_of(&s, &driven(&planner, &s, 150, 11));
+        let fine = WindowLooks::with_rays_per_pi(&s, &looks, 4096).exposure(0);
+        let used = WindowLooks::new(&s, &looks).exposure(0);
+        for (j, (a, b)) in used.iter().zip(&fine).enumerate() {
+            let rel = a / b - 1.0;
+            eprintln!(
+                "obstacles {obstacles}, source {j}: {} rays per π against 4096: {rel:+.2e}",
+                s.rays_per_pi()
+            );
+            assert!(
+                rel.abs() < 5e-3,
+                "obstacles {obstacles}, source {j}: {a} against {b}"
+            );
+        }
+    }
+}

@@ -14,12 +14,12 @@
 //! the zone at the window's first step are included.
 //!
 //! `τ` is integrated exactly (a sweep over interval ends); `α` by the
-//! midpoint rule on [`FIT_RAYS_PER_PI`] rays per π over the source's cone.
+//! midpoint rule over the source's cone, on the rays per π of the
+//! scenario's exact estimator (its error is in `docs/learning.md`).
 
 use rayon::prelude::*;
 
 use crate::geometry::{Point, detection_within};
-use crate::limits::FIT_RAYS_PER_PI;
 use crate::obstacle::Sight;
 use crate::scenario::{Look, Scenario};
 
@@ -27,20 +27,33 @@ use crate::scenario::{Look, Scenario};
 /// its obstacles hide) computed once.
 pub struct WindowLooks<'a> {
     s: &'a Scenario,
+    /// Rays per π of the angular grid.
+    rays_per_pi: usize,
     /// `(step, look, sight)`, in step order.
     looks: Vec<(usize, Look, Option<Sight>)>,
 }
 
 impl<'a> WindowLooks<'a> {
-    /// The looks of `steps` (step `i` at time `i`).
+    /// The looks of `steps` (step `i` at time `i`), integrated over the
+    /// rays per π of the scenario's exact estimator
+    /// ([`Scenario::rays_per_pi`]).
     pub fn new(s: &'a Scenario, steps: &[Vec<Look>]) -> Self {
+        Self::with_rays_per_pi(s, steps, s.rays_per_pi())
+    }
+
+    /// The same over `rays_per_pi` rays per π.
+    pub fn with_rays_per_pi(s: &'a Scenario, steps: &[Vec<Look>], rays_per_pi: usize) -> Self {
         let looks = steps
             .iter()
             .enumerate()
             .flat_map(|(t, looks)| looks.iter().map(move |l| (t, *l)))
             .map(|(t, l)| (t, l, s.sight(&l)))
             .collect();
-        WindowLooks { s, looks }
+        WindowLooks {
+            s,
+            rays_per_pi,
+            looks,
+        }
     }
 
     /// The number of (look, ray, class) triples the exposure walks: its
@@ -48,7 +61,7 @@ impl<'a> WindowLooks<'a> {
     pub fn work(&self) -> usize {
         (0..self.s.sources.len())
             .map(|j| {
-                let grid = RayGrid::of(self.s, j);
+                let grid = RayGrid::of(self.s, j, self.rays_per_pi);
                 let per_ray = self.s.classes_of(j).len();
                 self.looks
                     .iter()
@@ -78,7 +91,7 @@ impl<'a> WindowLooks<'a> {
         let s = self.s;
         let src = &s.sources[j];
         let classes = s.classes_of(j);
-        let grid = RayGrid::of(s, j);
+        let grid = RayGrid::of(s, j, self.rays_per_pi);
         // Looks bucketed by the rays that may cross them (compressed rows).
         let mut spans: Vec<(usize, usize)> = self
             .looks
@@ -159,24 +172,38 @@ impl<'a> WindowLooks<'a> {
                 classes
                     .iter()
                     .map(|c| {
-                        let emitted = |keep: &dyn Fn(usize) -> bool, sc: &mut RayScratch| {
+                        let v = c.speed;
+                        let times = |&(t, a, b, p): &(usize, f64, f64, f64)| {
+                            (t as f64 - b / v, t as f64 - a / v, p)
+                        };
+                        let (inf, sc) = (f64::INFINITY, &mut *sc);
+                        if fresh_from == 0 {
                             sc.times.clear();
-                            sc.times.extend(sc.pieces.iter().filter(|p| keep(p.0)).map(
-                                |&(t, a, b, p)| (t as f64 - b / c.speed, t as f64 - a / c.speed, p),
-                            ));
-                            detection_within(
-                                &sc.times,
-                                f64::NEG_INFINITY,
-                                f64::INFINITY,
-                                &mut sc.events,
-                            )
-                        };
-                        let all = emitted(&|_| true, sc);
-                        let old = if fresh_from == 0 {
-                            0.0
-                        } else {
-                            emitted(&|t| t < fresh_from, sc)
-                        };
+                            sc.times.extend(sc.pieces.iter().map(times));
+                            return c.share
+                                * detection_within(&sc.times, -inf, inf, &mut sc.events);
+                        }
+                        // Only the fresh looks' emission times can hold a
+                        // target they detect: the older pieces matter
+                        // there only, and elsewhere both sums agree.
+                        let (lo, hi) = sc
+                            .pieces
+                            .iter()
+                            .filter(|p| p.0 >= fresh_from)
+                            .map(times)
+                            .fold((inf, -inf), |(lo, hi), (a, b, _)| (lo.min(a), hi.max(b)));
+                        sc.times.clear();
+                        sc.times.extend(
+                            sc.pieces
+                                .iter()
+                                .filter(|p| p.0 < fresh_from)
+                                .map(times)
+                                .filter(|&(a, b, _)| b > lo && a < hi),
+                        );
+                        let old = detection_within(&sc.times, lo, hi, &mut sc.events);
+                        sc.times
+                            .extend(sc.pieces.iter().filter(|p| p.0 >= fresh_from).map(times));
+                        let all = detection_within(&sc.times, lo, hi, &mut sc.events);
                         c.share * (all - old).max(0.0)
                     })
                     .sum::<f64>()
@@ -205,10 +232,9 @@ struct RayGrid {
 }
 
 impl RayGrid {
-    fn of(s: &Scenario, j: usize) -> Self {
+    fn of(s: &Scenario, j: usize, rays_per_pi: usize) -> Self {
         let src = &s.sources[j];
-        let n =
-            ((src.spread / std::f64::consts::PI * FIT_RAYS_PER_PI as f64).ceil() as usize).max(1);
+        let n = ((src.spread / std::f64::consts::PI * rays_per_pi as f64).ceil() as usize).max(1);
         RayGrid {
             n,
             h: src.spread / n as f64,
