@@ -313,15 +313,23 @@ fn first_detection_pairs(planner: &Planner, input: &PlanInput) -> f64 {
 }
 
 /// Milliseconds per crossing of a fit's exposure (a look, a ray of the
-/// fit's grid that may cross it, a class: [`crate::fit::WindowLooks::work`]),
-/// the slower of the two measured in `docs/learning.md` (*Cost*), rounded
-/// up.
-const FIT_MS_PER_CROSSING: f64 = 7.0e-5;
+/// scenario's grid that may cross it, a class:
+/// [`crate::fit::WindowLooks::work`]) on a scenario without obstacles, and
+/// with them (a ground look's visible parts of each ray): measured in
+/// `docs/learning.md` (*Cost*), rounded up.
+const FIT_MS_PER_CROSSING: f64 = 6.0e-5;
+/// See [`FIT_MS_PER_CROSSING`].
+const FIT_MS_PER_CROSSING_WITH_OBSTACLES: f64 = 1.7e-4;
 
-/// Predicted CPU time of a fit whose exposure walks `crossings` crossings,
-/// milliseconds on one core.
-pub fn fit_ms(crossings: usize) -> f64 {
-    (crossings as f64 * FIT_MS_PER_CROSSING).max(FLOOR_MS)
+/// Predicted CPU time of a fit of scenario `s` whose exposure walks
+/// `crossings` crossings, milliseconds on one core.
+pub fn fit_ms(s: &Scenario, crossings: usize) -> f64 {
+    let per = if s.has_obstacles() {
+        FIT_MS_PER_CROSSING_WITH_OBSTACLES
+    } else {
+        FIT_MS_PER_CROSSING
+    };
+    (crossings as f64 * per).max(FLOOR_MS)
 }
 
 /// The least either model predicts: every term can be 0 (sources that

@@ -31,7 +31,7 @@ async fn fit_admitted(
 ) -> Result<(FitResponse, FitWindow), ApiError> {
     let window = FitWindow::new(&planner.scenario, &req)?;
     let crossings = WindowLooks::new(&planner.scenario, &window.looks).work();
-    refuse_if_costly(state, cost::fit_ms(crossings))?;
+    refuse_if_costly(state, cost::fit_ms(&planner.scenario, crossings))?;
     let guard = CancelOnDrop::new("fit", start, state);
     let res = super::queue::on_rayon(move || {
         let fitted = fit::fit(&planner.scenario, &window);

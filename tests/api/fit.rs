@@ -3,7 +3,9 @@
 use reqwest::StatusCode;
 use serde_json::{Value, json};
 
-use crate::helpers::{assert_problem, assert_validation, json_body, spawn_app};
+use vigil::http::config::Settings;
+
+use crate::helpers::{assert_problem, assert_validation, json_body, spawn_app, spawn_with};
 
 fn fit_request() -> Value {
     vigil::http::doc::examples::fit_request()
@@ -160,9 +162,15 @@ async fn a_long_window_fits_past_the_plan_body_limit() {
         json!({"steps": steps})
     };
     // 64 distinct looks a step over 500 steps is more work than a server
-    // takes: refused as a costly plan is.
+    // allowing 50 ms takes: refused as a costly plan is.
+    let strict = spawn_with(Settings {
+        max_plan_ms: Some(50.0),
+        ..Settings::default()
+    })
+    .await;
     assert_problem(
-        app.post_json("/v1/scenarios/paper-v10/fit", &window(64))
+        strict
+            .post_json("/v1/scenarios/paper-v10/fit", &window(64))
             .await,
         StatusCode::UNPROCESSABLE_ENTITY,
         "--max-plan-ms",
