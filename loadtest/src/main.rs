@@ -343,6 +343,11 @@ struct InprocArgs {
     /// state.
     #[arg(long)]
     session: bool,
+    /// With `--session`: sessions that learn the rates (`learn_rates`), so
+    /// each step also folds its looks and detections into the posteriors
+    /// and plans at the learnt rates (docs/learning.md).
+    #[arg(long, requires = "session")]
+    learn: bool,
     /// Timed plans (or session steps), cycling through the requests.
     #[arg(long, default_value_t = 2000)]
     iterations: usize,
@@ -525,9 +530,12 @@ fn certify_cmd(a: &CertifyArgs) -> Result<()> {
 }
 
 fn inproc_session_cmd(a: &InprocArgs) -> Result<()> {
-    let (reqs, wl) = a
+    let (reqs, mut wl) = a
         .workload
         .session(&requests::planner_for(&a.workload.scenario)?)?;
+    if a.learn {
+        wl.settings.learn_rates = Some(true);
+    }
     let planner = Arc::new(a.planner()?);
     let r = session::measure(&planner, &wl, Some(&reqs), a.iterations)?;
     let s = &r.steps;

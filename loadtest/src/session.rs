@@ -23,19 +23,29 @@ use crate::inproc::{InprocReport, from_nanos};
 use crate::workload::SessionWorkload;
 
 /// One step of `session`, as the server does it for
-/// `POST /v1/sessions/{id}/step`: the stateless request of the session's
-/// state with this step ([`Session::prepare`]), its plan, and the step
-/// recorded ([`Session::commit`]). A step whose plan fails changes nothing.
+/// `POST /v1/sessions/{id}/step`: a learning session's fold of the step
+/// ([`vigil::fit::RateLearner::fold`]), the stateless request of the
+/// session's state with this step ([`Session::prepare`]), its plan (at the
+/// learnt rates), and the step recorded ([`Session::commit`]). A step
+/// whose plan fails changes nothing.
 ///
 /// # Errors
-/// If the planner refuses the step's request.
+/// If the learner or the planner refuses the step.
 pub fn session_step(session: &mut Session, step: &StepRequest) -> Result<PlanResponse> {
+    let learnt = session
+        .learner()
+        .map(|l| l.fold(&step.sensors, &step.detections))
+        .transpose()
+        .context("the learning session refused the step")?;
     let prepared = session.prepare(step);
     let plan = session
-        .planner()
+        .planner_for(learnt.as_ref())
         .plan_request(&prepared.request)
         .context("the session's step was refused")?;
     session.commit(prepared);
+    if let Some(learnt) = learnt {
+        session.commit_learnt(learnt);
+    }
     Ok(plan)
 }
 
