@@ -302,6 +302,16 @@ impl Sim {
         }
     }
 
+    /// Replaces the (still empty) world by one drawn from its stationary
+    /// distribution ([`World::stationary`]): targets emitted over a window
+    /// long enough for any to have crossed the zone, as if the sources had
+    /// always emitted. Drawn from the targets' own RNG, so every policy of
+    /// a seed still sees the same targets. Call it before the first step.
+    pub fn start_stationary(&mut self) {
+        self.world = World::stationary(&self.scenario, &mut self.world_rng);
+        self.sense();
+    }
+
     /// Starts counting the targets that enter the zone from now
     /// ([`Sim::entries`]); those in it now are never counted.
     pub fn start_window(&mut self) {
@@ -525,7 +535,10 @@ impl Sim {
     }
 
     /// The settings of a session that plans for `policy` with `history`
-    /// steps of history, as [`Sim::plan_request`] does.
+    /// steps of history, as [`Sim::plan_request`] does; a policy that
+    /// learns the rates ([`Policy::learns_rates`]) asks for
+    /// `learn_rates: true` (its steps' detections carry their targets' ids,
+    /// as every session step's do).
     pub fn session_settings(
         &self,
         policy: Policy,
@@ -544,8 +557,11 @@ impl Sim {
             min_separation: self.min_separation.map(Into::into),
             history_steps: Some(history.into()),
             certify: None,
-            learn_rates: None,
-            tolerance: None,
+            // Only when learning: other sessions' settings stay as they were.
+            learn_rates: policy.learns_rates().then_some(true),
+            // The server's defaults for the rest (the simulator's tracks
+            // are exact: no tracker tolerances).
+            ..SessionSettings::default()
         }
     }
 

@@ -8,10 +8,12 @@ use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use tokio::sync::Semaphore;
 use vigil::coordination::Objective;
+use vigil::fit::SourceRate;
 use vigil::scenario::Scenario;
 
 use crate::client::{Client, ClientError};
 use crate::driver::{Sim, Start, checked_bound, fleet_types};
+use crate::learn::{Learning, Learnt, Tracker};
 use crate::metrics::{Metrics, RunAccumulator, StepCount, summarize};
 use crate::policy::{ALL_POLICIES, Policy};
 use crate::rates::WorldRates;
@@ -65,6 +67,10 @@ pub struct RunConfig {
     /// registered with the world's rates. Recorded in the report; `None`:
     /// the world emits at the rates the planner is told.
     pub world_rates: Option<WorldRates>,
+    /// The world starts in its stationary state ([`Sim::start_stationary`])
+    /// instead of empty (`--stationary-start`); the warm-up still runs. A
+    /// learning session assumes a stationary world from its first step.
+    pub stationary_start: bool,
 }
 
 impl RunConfig {
@@ -93,6 +99,9 @@ impl RunConfig {
         );
         sim.min_separation = self.min_separation;
         sim.blind = self.blind;
+        if self.stationary_start {
+            sim.start_stationary();
+        }
         sim
     }
 }
@@ -124,26 +133,84 @@ pub enum RunError {
 }
 
 /// Runs one seed. Returns the run's averages and, when `keep` is set, the
-/// finished simulation (for pictures).
+/// finished simulation (for pictures). [`run_learning`] also gives what a
+/// learning policy learnt.
 pub async fn run_one(
     client: &Client,
     cfg: &RunConfig,
     seed: u64,
     keep: bool,
 ) -> Result<(Metrics, Option<Sim>), RunError> {
+    let out = run_learning(client, cfg, seed, keep).await?;
+    Ok((out.metrics, out.sim))
+}
+
+/// One seed's run, all it gives.
+pub struct RunOutcome {
+    /// The run's averages.
+    pub metrics: Metrics,
+    /// A policy that learns the rates ([`Policy::learns_rates`]): what it
+    /// learnt.
+    pub learnt: Option<Learnt>,
+    /// The session's rates before its first step (its prior's means: the
+    /// rates the planner was told), for a learning policy.
+    pub prior_rates: Option<Vec<f64>>,
+    /// The finished simulation, when asked for.
+    pub sim: Option<Sim>,
+}
+
+/// The world's rate of each source: `cfg.scenario`'s, the world's (with
+/// `--world-rates` already applied).
+pub fn true_rates(cfg: &RunConfig) -> Vec<f64> {
+    cfg.scenario.sources.iter().map(|s| s.rate).collect()
+}
+
+/// Runs one seed, as [`run_one`], and for a policy that learns the rates
+/// follows them step by step: it plans through a learning session
+/// (`learn_rates: true`) whatever `cfg.session` says, and checks that
+/// every step's response has `rates`.
+pub async fn run_learning(
+    client: &Client,
+    cfg: &RunConfig,
+    seed: u64,
+    keep: bool,
+) -> Result<RunOutcome, RunError> {
     let planner = cfg.policy.planner().is_some();
-    let session = cfg.session && planner;
+    let learns = cfg.policy.learns_rates();
+    let session = (cfg.session && planner) || learns;
+    let mut tracker = learns.then(|| Tracker::new(true_rates(cfg)));
+    // A learning session's step must report its rates.
+    let mut follow = |rates: Option<&[SourceRate]>| -> Result<(), RunError> {
+        match (tracker.as_mut(), rates) {
+            (Some(t), Some(rates)) => t.add(rates).map_err(RunError::Contract),
+            (Some(_), None) => Err(RunError::Contract(
+                "a learning session's step without its rates".into(),
+            )),
+            (None, _) => Ok(()),
+        }
+    };
+    let mut prior_rates = None;
     let (mut sim, session) = if session {
         // The session must see every step, the warm-up's too, to hold the
-        // history and tracks the stateless requests would carry.
+        // history and tracks the stateless requests would carry (and, when
+        // learning, to count every target and look).
         let mut sim = cfg.fresh(seed);
         let settings = sim.session_settings(cfg.policy, cfg.horizon, cfg.history);
-        let id = client.open_session(&cfg.scenario_id, &settings).await?.id;
+        let info = client.open_session(&cfg.scenario_id, &settings).await?;
+        if learns {
+            let rates = info
+                .rates
+                .as_deref()
+                .ok_or_else(|| RunError::Contract("a learning session without its rates".into()))?;
+            prior_rates = Some(rates.iter().map(|r| r.rate).collect());
+        }
+        let id = info.id;
         for _ in 0..cfg.warmup {
             sim.observe();
-            client
+            let (resp, _) = client
                 .step(&id, &sim.step_request(cfg.policy, cfg.horizon))
                 .await?;
+            follow(resp.rates.as_deref())?;
             let stay = sim.sensors.clone();
             sim.advance(stay);
         }
@@ -161,6 +228,7 @@ pub async fn run_one(
                     let (resp, ms) = client
                         .step(id, &sim.step_request(cfg.policy, cfg.horizon))
                         .await?;
+                    follow(resp.rates.as_deref())?;
                     (resp.plan, ms)
                 }
                 None => {
@@ -194,7 +262,12 @@ pub async fn run_one(
         client.close_session(id).await?;
     }
     let metrics = acc.finish(sim.entries());
-    Ok((metrics, keep.then_some(sim)))
+    Ok(RunOutcome {
+        metrics,
+        learnt: tracker.map(|t| t.finish(seed)),
+        prior_rates,
+        sim: keep.then_some(sim),
+    })
 }
 
 /// What a plan's first step predicts, as it happened: the targets detected
@@ -236,10 +309,18 @@ pub struct Row {
     /// The planner was told the world's rates (`--tell-world-rates`:
     /// `scenario` is the spec registered with them), not the scenario's.
     pub told_world_rates: bool,
+    /// The world started in its stationary state (`--stationary-start`);
+    /// absent when it started empty.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub stationary_start: bool,
     /// Means over seeds.
     pub metrics: Metrics,
     /// Half-widths of the 95% confidence intervals.
     pub ci95: Metrics,
+    /// A policy that learns the rates (`exact-learn`): what it learnt,
+    /// against the world's rates. Absent for the other policies.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub learning: Option<Learning>,
 }
 
 /// Runs every configuration for seeds `seed..seed+seeds` (the same seeds,
@@ -272,26 +353,39 @@ pub async fn run_all(
                 (client.clone(), cfg.clone(), permits.clone(), bar.clone());
             tasks.spawn(async move {
                 let _permit = permits.acquire_owned().await;
-                let out = run_one(&client, &cfg, seed + k as u64, false).await;
+                let out = run_learning(&client, &cfg, seed + k as u64, false).await;
                 bar.inc(1);
                 bar.set_message(cfg.label.clone());
                 (ci, k, out)
             });
         }
     }
-    let mut results: Vec<Vec<Option<Metrics>>> = vec![vec![None; seeds]; configs.len()];
+    let mut results: Vec<Vec<Option<RunOutcome>>> = (0..configs.len())
+        .map(|_| (0..seeds).map(|_| None).collect())
+        .collect();
     while let Some(joined) = tasks.join_next().await {
         let (ci, k, out) =
             joined.map_err(|e| RunError::Contract(format!("a run panicked: {e}")))?;
-        results[ci][k] = Some(out?.0);
+        results[ci][k] = Some(out?);
     }
     bar.finish_and_clear();
     Ok(configs
         .iter()
         .zip(results)
-        .map(|(cfg, runs)| {
-            let runs: Vec<Metrics> = runs.into_iter().flatten().collect();
+        .map(|(cfg, outcomes)| {
+            let outcomes: Vec<RunOutcome> = outcomes.into_iter().flatten().collect();
+            let runs: Vec<Metrics> = outcomes.iter().map(|o| o.metrics).collect();
             let (metrics, ci95) = summarize(&runs);
+            let prior_rates = outcomes.iter().find_map(|o| o.prior_rates.clone());
+            let learnt: Vec<Learnt> = outcomes.into_iter().filter_map(|o| o.learnt).collect();
+            let learning = (!learnt.is_empty()).then(|| {
+                crate::learn::summarize(
+                    learnt,
+                    true_rates(cfg),
+                    prior_rates.unwrap_or_default(),
+                    cfg.warmup,
+                )
+            });
             Row {
                 label: cfg.label.clone(),
                 policy: cfg.policy.name().to_owned(),
@@ -304,8 +398,10 @@ pub async fn run_all(
                 seeds: runs.len(),
                 world_rates: cfg.world_rates.as_ref().map(|w| w.scales.clone()),
                 told_world_rates: cfg.world_rates.as_ref().is_some_and(|w| w.told),
+                stationary_start: cfg.stationary_start,
                 metrics,
                 ci95,
+                learning,
             }
         })
         .collect())
@@ -370,7 +466,7 @@ pub fn experiment_policies(name: &str) -> Option<Vec<(char, Policy)>> {
 /// The rows of an experiment that runs only the policies `chosen`, in the
 /// order given (repeats dropped), or all of its own when `chosen` is empty.
 /// A policy keeps its letter from the experiment's own list, so `1d` is
-/// `exact-iterated` in every Table 2; one outside it (`exact-joint`) takes
+/// `exact-iterated` in every Table 2; one outside it (`exact-joint`, `exact-learn`) takes
 /// the letters after that list's, in the order given.
 pub fn chosen_policies(name: &str, chosen: &[Policy]) -> Option<Vec<(char, Policy)>> {
     let own = experiment_policies(name)?;
@@ -401,6 +497,7 @@ mod tests {
         let all = chosen_policies("table2", &[]).expect("table2");
         assert_eq!(all.len(), ALL_POLICIES.len());
         assert!(!all.iter().any(|&(_, p)| p == Policy::ExactJoint));
+        assert!(!all.iter().any(|&(_, p)| p.learns_rates()));
         let two = chosen_policies(
             "table2",
             &[
@@ -419,6 +516,21 @@ mod tests {
         assert_eq!(
             chosen_policies("table1", &[Policy::Paper, Policy::ExactJoint]),
             Some(vec![('a', Policy::Paper), ('c', Policy::ExactJoint)])
+        );
+        assert_eq!(
+            chosen_policies(
+                "mixed",
+                &[
+                    Policy::ExactLearn,
+                    Policy::ExactIterated,
+                    Policy::ExactJoint
+                ]
+            ),
+            Some(vec![
+                ('j', Policy::ExactLearn),
+                ('d', Policy::ExactIterated),
+                ('k', Policy::ExactJoint)
+            ])
         );
         assert_eq!(chosen_policies("table3", &[Policy::Paper]), None);
     }

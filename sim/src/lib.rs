@@ -6,6 +6,7 @@
 //! - [`metrics`]: per-step counts, per-run averages, confidence intervals;
 //! - [`client`]: the HTTP client, and an in-process server for one-command runs;
 //! - [`experiment`]: runs over seeds and the paper's experiment grids;
+//! - [`learn`]: what a policy that learns the rates learnt;
 //! - [`live`]: the live view, one run watched in a browser;
 //! - [`rates`]: a world whose sources emit at other rates than the planner
 //!   is told;
@@ -15,6 +16,7 @@
 pub mod client;
 pub mod driver;
 pub mod experiment;
+pub mod learn;
 pub mod live;
 pub mod metrics;
 pub mod policy;

@@ -13,6 +13,7 @@
 //! vigil-sim --experiment table1 --min-separation 3 # sensors ≥ 3 cells apart
 //! vigil-sim --policy exact --world-rates 3          # the world emits 3× what the planner is told
 //! vigil-sim --policy exact --world-rates 3 --tell-world-rates   # … and the planner is told
+//! vigil-sim --policy exact-learn --world-rates 3    # … or learns them from its detections
 //! ```
 //! Without `--server` it starts a server in-process on a loopback port and
 //! still talks HTTP to it.
@@ -43,16 +44,18 @@ struct Args {
     /// `table2` (every policy) over NS ∈ {10, 6} × TV ∈ {10, 15}, or `mixed`
     /// (every policy on `site-gates` with NS ∈ {10, 6}), or `fleet` (every
     /// policy on `site-fleet` with ten robots, four drones and six robots,
-    /// ten drones). "Every policy" leaves out `exact-joint`; `--policy`
-    /// picks the rows' policies instead, e.g.
+    /// ten drones). "Every policy" leaves out `exact-joint` and
+    /// `exact-learn`; `--policy` picks the rows' policies instead, e.g.
     /// `--policy exact-iterated,exact-joint`.
     #[arg(long)]
     experiment: Option<String>,
     /// Policy of a single run (`exact` by default). With `--experiment`,
     /// the experiment runs these policies instead of its own (each keeps
-    /// its row letter; `exact-joint`, in no experiment's own list, comes
-    /// after). Comma-separated or repeated; several without
-    /// `--experiment` run one row each.
+    /// its row letter; `exact-joint` and `exact-learn`, in no experiment's
+    /// own list, come after). Comma-separated or repeated; several without
+    /// `--experiment` run one row each. `exact-learn` plans through a
+    /// session that learns the sources' rates, with or without
+    /// `--session`, and reports what it learnt under the table.
     #[arg(long, value_enum, value_delimiter = ',')]
     policy: Vec<Policy>,
     /// Number of sensors of a single run.
@@ -90,7 +93,8 @@ struct Args {
     start: Start,
     /// Plan through sessions (`POST /v1/sessions/{id}/step`: the server
     /// keeps the history and the tracks) instead of stateless requests; the
-    /// plans and metrics are the same.
+    /// plans and metrics are the same. `exact-learn` always plans through
+    /// a (learning) session.
     #[arg(long)]
     session: bool,
     /// A running vigil-server (e.g. http://127.0.0.1:8080); by default one
@@ -146,6 +150,14 @@ struct Args {
     /// planner told the wrong rates).
     #[arg(long)]
     tell_world_rates: bool,
+    /// The world starts in its stationary state, as if its sources had
+    /// always emitted (targets drawn from the world's own RNG, so every
+    /// policy of a seed still sees the same ones), instead of empty; the
+    /// warm-up still runs. A learning session (`exact-learn`) assumes a
+    /// stationary world from its first step: in a world filling up from
+    /// empty, what it learns during the fill is biased low.
+    #[arg(long)]
+    stationary_start: bool,
 }
 
 #[tokio::main]
@@ -307,6 +319,7 @@ async fn run(args: Args) -> Result<(), String> {
                 session: args.session,
                 blind: args.blind,
                 world_rates: on.world_rates.clone(),
+                stationary_start: args.stationary_start,
             }
         };
     if args.blind && args.experiment.is_some() {
@@ -402,6 +415,12 @@ async fn run(args: Args) -> Result<(), String> {
     if args.live {
         if args.experiment.is_some() {
             return Err("--live shows a single run; drop --experiment".into());
+        }
+        if configs[0].policy.learns_rates() {
+            return Err(format!(
+                "--live plans with stateless requests, which learn no rates: {} needs a run without --live",
+                configs[0].policy
+            ));
         }
         let opts = LiveOptions {
             run: configs[0].clone(),

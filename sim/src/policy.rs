@@ -40,13 +40,21 @@ pub enum Policy {
     /// Exact estimator, iterated coordination, maximising first detections
     /// (the intrusion objective): each target not yet detected counts once.
     ExactIntrusion,
+    /// Exact estimator, iterated coordination, planned through a learning
+    /// session (`learn_rates: true`) whatever `--session` says: the server
+    /// learns the sources' rates from the detections (each with its
+    /// target's id) and plans with the posterior means. Experiments run it
+    /// only when named.
+    ExactLearn,
 }
 
 /// The policies the experiments run by default, in report order: every
-/// policy but [`Policy::ExactJoint`]. Its plans take up to their time
-/// budget each, several times an iterated plan, so a grid of every policy
-/// would take several times as long; it is run by naming it
-/// (`--policy exact-joint`), after these in an experiment's rows.
+/// policy but [`Policy::ExactJoint`] and [`Policy::ExactLearn`]. Joint
+/// plans take up to their time budget each, several times an iterated
+/// plan, so a grid of every policy would take several times as long; a
+/// learning session precomputes its scenario again as its rates move. Each
+/// is run by naming it (`--policy exact-joint`, `--policy exact-learn`),
+/// after these in an experiment's rows.
 pub const ALL_POLICIES: [Policy; 9] = [
     Policy::Paper,
     Policy::PaperUncoordinated,
@@ -86,6 +94,7 @@ impl Policy {
             Policy::ExactJoint => (E::Exact, C::Joint, Observed::Sensors),
             Policy::Clairvoyant => (E::Exact, C::Iterated, Observed::Zone),
             Policy::ExactIntrusion => (E::Exact, C::Iterated, Observed::Sensors),
+            Policy::ExactLearn => (E::Exact, C::Iterated, Observed::Sensors),
         };
         let objective = if self == Policy::ExactIntrusion {
             Objective::FirstDetections
@@ -98,6 +107,13 @@ impl Policy {
             observed,
             objective,
         })
+    }
+
+    /// The policy plans through a session that learns the sources' rates
+    /// (`learn_rates: true`), whether or not the run plans through
+    /// sessions otherwise.
+    pub fn learns_rates(self) -> bool {
+        self == Policy::ExactLearn
     }
 
     /// The policy's name on the command line and in reports.
@@ -113,6 +129,7 @@ impl Policy {
             Policy::ExactJoint => "exact-joint",
             Policy::Clairvoyant => "clairvoyant",
             Policy::ExactIntrusion => "exact-intrusion",
+            Policy::ExactLearn => "exact-learn",
         }
     }
 }

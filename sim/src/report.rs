@@ -31,7 +31,8 @@ fn opt(mean: Option<f64>, ci: Option<f64>, decimals: usize) -> String {
 /// without a certificate (the paper estimator, local policies)); NS shows
 /// the fleet
 /// (`drone:4,robot:6`) when the sensors have types, each mean ± the
-/// half-width of its 95% confidence interval over seeds.
+/// half-width of its 95% confidence interval over seeds. Rows of a policy
+/// that learns the rates add [`learning`]'s lines under the table.
 pub fn table(rows: &[Row]) -> String {
     let header = [
         "EN", "NS", "AD", "ZD", "AF", "D1S", "D2S", "D3S", "D4+S", "TV", "policy", "once", "delay",
@@ -91,12 +92,61 @@ pub fn table(rows: &[Row]) -> String {
     for row in &body {
         line(&mut row.iter().map(String::as_str), &mut out);
     }
+    out.push_str(&learning(rows));
+    out
+}
+
+/// The lines under the table for the rows of a policy that learns the
+/// rates (none without one): per row, `steps_to_20pct` (the mean over the
+/// seeds that reached it ± its 95% interval, and how many did), then each
+/// source's last learnt rate (mean ± 95% interval over seeds) and, in
+/// brackets, the world's.
+pub fn learning(rows: &[Row]) -> String {
+    let mut out = String::new();
+    for r in rows {
+        let Some(l) = &r.learning else { continue };
+        if out.is_empty() {
+            let _ = writeln!(
+                out,
+                "learnt rates: steps_to_20pct counts steps from the first warm-up step \
+                 (1), warm-up included; last rate per source (world's rate):"
+            );
+        }
+        let reached = match (l.steps_to_20pct, l.steps_to_20pct_ci95) {
+            (Some(m), Some(c)) => format!("{m:.1}±{c:.1}"),
+            _ => "never".to_owned(),
+        };
+        let rates: Vec<String> = l
+            .rates
+            .iter()
+            .zip(&l.rates_ci95)
+            .zip(&l.true_rates)
+            .map(|((m, c), t)| format!("{m:.3}±{c:.3} ({t:.3})"))
+            .collect();
+        // A single run's label is its policy's name.
+        let name = if r.label == r.policy {
+            r.policy.clone()
+        } else {
+            format!("{} {}", r.label, r.policy)
+        };
+        let _ = writeln!(
+            out,
+            "  {name}: steps_to_20pct {reached} ({}/{} seeds reached it; {} warm-up + {} measured steps); {}",
+            l.reached_20pct,
+            l.seeds,
+            l.warmup,
+            l.steps.saturating_sub(l.warmup),
+            rates.join(", ")
+        );
+    }
     out
 }
 
 /// The JSON report: `{"runs":[{label, policy, scenario, sensors, fleet,
 /// target_speed, steps, min_separation, seeds, world_rates,
-/// told_world_rates, metrics, ci95}]}`.
+/// told_world_rates, metrics, ci95}]}`, and `learning`
+/// ([`crate::learn::Learning`]) in the rows of a policy that learns the
+/// rates.
 pub fn json(rows: &[Row]) -> serde_json::Result<String> {
     #[derive(Serialize)]
     struct Report<'a> {

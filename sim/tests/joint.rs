@@ -28,6 +28,7 @@ fn config(policy: Policy, id: &str, scenario: &Scenario, steps: usize) -> RunCon
         session: false,
         blind: false,
         world_rates: None,
+        stationary_start: false,
     }
 }
 

@@ -165,6 +165,7 @@ async fn live_view_in_headless_chromium() {
         session: false,
         blind: false,
         world_rates: None,
+        stationary_start: false,
     };
     let listener = tokio::net::TcpListener::bind("127.0.0.1:0")
         .await
@@ -437,6 +438,7 @@ async fn live_view_draws_obstacles_and_views() {
         session: false,
         blind: false,
         world_rates: None,
+        stationary_start: false,
     };
     let listener = tokio::net::TcpListener::bind("127.0.0.1:0")
         .await

@@ -365,6 +365,7 @@ async fn uncoordinated_planner_keeps_apart_in_closed_loop() {
         session: false,
         blind: false,
         world_rates: None,
+        stationary_start: false,
     };
     let mut means = Vec::new();
     for d in [0, 3] {

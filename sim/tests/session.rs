@@ -154,6 +154,7 @@ async fn vigil_sim_through_sessions_gives_the_same_metrics() {
         session,
         blind: false,
         world_rates: None,
+        stationary_start: false,
     };
     for seed in [1, 2] {
         let (stateless, _) = run_one(&client, &cfg(false), seed, false)

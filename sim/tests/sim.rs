@@ -175,6 +175,7 @@ async fn end_to_end_over_http() {
             session: false,
             blind: false,
             world_rates: None,
+            stationary_start: false,
         })
         .collect();
     let rows = run_all(&client, &configs, 7, 2, 4).await.expect("runs");
@@ -400,6 +401,7 @@ async fn fleets_move_within_their_speeds_around_no_go_zones() {
         session: false,
         blind: false,
         world_rates: None,
+        stationary_start: false,
     };
     let (metrics, sim) = run_one(&client, &cfg, 5, true).await.expect("run");
     let sim = sim.expect("kept");
@@ -552,6 +554,7 @@ async fn site_campus_runs_aware_and_blind() {
         session: false,
         blind,
         world_rates: None,
+        stationary_start: false,
     };
     let mut calibration = Vec::new();
     for (id, blind) in [(info.id.as_str(), false), (blind.id.as_str(), true)] {
