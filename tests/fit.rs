@@ -13,7 +13,7 @@ use serde_json::{Value, json};
 use vigil::fit::{
     Attribution, DetectionIn, FitRequest, FitStep, FitTolerance, FitWindow, Prior, WindowLooks,
 };
-use vigil::planner::{Id, Planner, SensorIn, TargetIn};
+use vigil::planner::{Id, PlanResponse, Planner, SensorIn, TargetIn};
 use vigil::scenario::{Scenario, ScenarioSpec};
 use vigil::session::{Session, SessionSettings, StepRequest};
 use vigil::world::World;
@@ -96,7 +96,22 @@ fn driven(
         .collect();
     let mut out = Vec::new();
     for _ in 0..steps {
-        let detections = detect(world_s, &world, &sensors, &mut rng)
+        let step = step_request(&sensors, detect(world_s, &world, &sensors, &mut rng));
+        let next = session.prepare(&step);
+        let plan = planner.plan_request(&next.request).unwrap();
+        session.commit(next);
+        out.push(sensors.clone());
+        follow(s, &mut sensors, &plan);
+        world.step(world_s, &mut rng);
+    }
+    out
+}
+
+/// A session step: the sensors now and their detections, with ids.
+fn step_request(sensors: &[SensorIn], detections: Vec<DetectionIn>) -> StepRequest {
+    StepRequest {
+        sensors: sensors.to_vec(),
+        detections: detections
             .into_iter()
             .map(|d| TargetIn {
                 id: Some(d.id),
@@ -105,27 +120,20 @@ fn driven(
                 vx: d.vx,
                 vy: d.vy,
             })
-            .collect();
-        let step = StepRequest {
-            sensors: sensors.clone(),
-            detections,
-            ..StepRequest::default()
-        };
-        let next = session.prepare(&step);
-        let plan = planner.plan_request(&next.request).unwrap();
-        session.commit(next);
-        out.push(sensors.clone());
-        for (sensor, p) in sensors.iter_mut().zip(&plan.plans) {
-            let c = s.centre(vigil::scenario::Cell {
-                col: p.path[0].col,
-                row: p.path[0].row,
-            });
-            sensor.x = c.x;
-            sensor.y = c.y;
-        }
-        world.step(world_s, &mut rng);
+            .collect(),
+        ..StepRequest::default()
     }
-    out
+}
+
+/// Moves each sensor to the first cell of its plan.
+fn follow(s: &Scenario, sensors: &mut [SensorIn], plan: &PlanResponse) {
+    for (sensor, p) in sensors.iter_mut().zip(&plan.plans) {
+        let c = s.centre(vigil::scenario::Cell {
+            col: p.path[0].col,
+            row: p.path[0].row,
+        });
+        (sensor.x, sensor.y) = (c.x, c.y);
+    }
 }
 
 /// What the looks of `sensors` detect in `world` now: each target in the
@@ -497,20 +505,7 @@ fn a_learning_session_counts_what_a_window_fit_counts() {
             sensors: sensors.clone(),
             detections: detections.clone(),
         });
-        let step = StepRequest {
-            sensors: sensors.clone(),
-            detections: detections
-                .into_iter()
-                .map(|d| TargetIn {
-                    id: Some(d.id),
-                    x: d.x,
-                    y: d.y,
-                    vx: d.vx,
-                    vy: d.vy,
-                })
-                .collect(),
-            ..StepRequest::default()
-        };
+        let step = step_request(&sensors, detections);
         let learnt = session
             .learner()
             .unwrap()
@@ -524,13 +519,7 @@ fn a_learning_session_counts_what_a_window_fit_counts() {
         let plan = planner.plan_request(&prepared.request).unwrap();
         session.commit(prepared);
         session.commit_learnt(learnt);
-        for (sensor, p) in sensors.iter_mut().zip(&plan.plans) {
-            let c = s.centre(vigil::scenario::Cell {
-                col: p.path[0].col,
-                row: p.path[0].row,
-            });
-            (sensor.x, sensor.y) = (c.x, c.y);
-        }
+        follow(&s, &mut sensors, &plan);
         world.step(&world_s, &mut rng);
     }
     // The plans moved to the learnt rates, away from the spec's.

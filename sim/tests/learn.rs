@@ -5,79 +5,17 @@
 //! rates, the world's and `steps_to_20pct`; the policy runs in an
 //! experiment when named, in no experiment's default rows, and not live.
 
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
+mod common;
 
 use serde_json::Value;
 
-const BIN: &str = env!("CARGO_BIN_EXE_vigil-sim");
+use common::{TempDir, args, rows, run_all};
 
 /// `paper-v10`: eight sources of rate 0.3; targets at speed 10 in a 300 m
 /// square, so the default warm-up is ⌈300·√2 / 10⌉ = 43 steps.
 const PAPER_SOURCES: usize = 8;
 const PAPER_RATE: f64 = 0.3;
 const PAPER_WARMUP: usize = 43;
-
-/// A temporary directory of one test.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> Self {
-        let dir =
-            std::env::temp_dir().join(format!("vigil-sim-learn-{name}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).expect("temp dir");
-        TempDir(dir)
-    }
-
-    fn json(&self, name: &str) -> PathBuf {
-        self.0.join(format!("{name}.json"))
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-/// Runs the commands (each `vigil-sim ARGS`, with its own in-process
-/// server) at once; their outputs in order.
-fn run_all(commands: &[Vec<String>]) -> Vec<Output> {
-    let children: Vec<Child> = commands
-        .iter()
-        .map(|args| {
-            Command::new(BIN)
-                .args(args)
-                .stdout(Stdio::piped())
-                .stderr(Stdio::piped())
-                .spawn()
-                .expect("vigil-sim starts")
-        })
-        .collect();
-    children
-        .into_iter()
-        .map(|c| c.wait_with_output().expect("vigil-sim ends"))
-        .collect()
-}
-
-fn args(words: &[&str], json: &Path) -> Vec<String> {
-    let mut v: Vec<String> = words.iter().map(|&w| w.to_owned()).collect();
-    v.push("--json".into());
-    v.push(json.display().to_string());
-    v
-}
-
-/// The rows of a successful run's JSON report at `json`.
-fn rows(out: &Output, json: &Path) -> Vec<Value> {
-    assert!(
-        out.status.success(),
-        "vigil-sim failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let report: Value =
-        serde_json::from_str(&std::fs::read_to_string(json).expect("report")).expect("JSON");
-    report["runs"].as_array().expect("runs").clone()
-}
 
 fn numbers(v: &Value) -> Vec<f64> {
     v.as_array()
@@ -101,7 +39,7 @@ fn close(a: &[f64], b: &[f64]) -> bool {
 /// `learning`.
 #[test]
 fn exact_learn_learns_rates_above_and_below_the_told_ones() {
-    let dir = TempDir::new("rates");
+    let dir = TempDir::new("learn-rates");
     let common = [
         "--scenario",
         "paper-v10",
@@ -218,7 +156,7 @@ fn exact_learn_learns_rates_above_and_below_the_told_ones() {
 /// statelessly, refuses it.
 #[test]
 fn exact_learn_in_an_experiment_when_named_and_not_live() {
-    let dir = TempDir::new("experiment");
+    let dir = TempDir::new("learn-experiment");
     let (named, default) = (dir.json("named"), dir.json("default"));
     let outs = run_all(&[
         args(
@@ -305,7 +243,7 @@ fn exact_learn_in_an_experiment_when_named_and_not_live() {
 /// few targets of one step; the report marks the row.
 #[test]
 fn a_stationary_start_fills_the_zone_at_once() {
-    let dir = TempDir::new("stationary");
+    let dir = TempDir::new("learn-stationary");
     let (full, empty) = (dir.json("full"), dir.json("empty"));
     let common = [
         "--policy",

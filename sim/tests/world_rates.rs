@@ -5,73 +5,17 @@
 //! forecasts are off, or calibrated), in single runs, sessions and
 //! experiments; the JSON report records the scales; bad values are errors.
 
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
+mod common;
 
 use serde_json::Value;
-use vigil_sim::client::{Client, spawn_local_server};
 
-const BIN: &str = env!("CARGO_BIN_EXE_vigil-sim");
+use common::{TempDir, args, rows, run_all};
+use vigil_sim::client::{Client, spawn_local_server};
 
 /// `paper-v10`: eight sources of rate 0.3; targets at speed 10 in a 300 m
 /// square.
 const PAPER_SOURCES: usize = 8;
 const PAPER_RATE: f64 = 0.3;
-
-/// A temporary directory of one test.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> Self {
-        let dir = std::env::temp_dir().join(format!("vigil-sim-{name}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).expect("temp dir");
-        TempDir(dir)
-    }
-
-    fn json(&self, name: &str) -> PathBuf {
-        self.0.join(format!("{name}.json"))
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-/// Starts `vigil-sim ARGS` (its output captured).
-fn start(args: &[&str]) -> Child {
-    Command::new(BIN)
-        .args(args)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("vigil-sim starts")
-}
-
-/// Runs the commands at once; their outputs in order.
-fn run_all(commands: &[Vec<String>]) -> Vec<Output> {
-    let children: Vec<Child> = commands
-        .iter()
-        .map(|args| start(&args.iter().map(String::as_str).collect::<Vec<_>>()))
-        .collect();
-    children
-        .into_iter()
-        .map(|c| c.wait_with_output().expect("vigil-sim ends"))
-        .collect()
-}
-
-/// The rows of a successful run's JSON report at `json`.
-fn rows(out: &Output, json: &Path) -> Vec<Value> {
-    assert!(
-        out.status.success(),
-        "vigil-sim failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let report: Value =
-        serde_json::from_str(&std::fs::read_to_string(json).expect("report")).expect("JSON");
-    report["runs"].as_array().expect("runs").clone()
-}
 
 fn metric(row: &Value, key: &str) -> f64 {
     row["metrics"][key]
@@ -87,13 +31,6 @@ fn in_zone(row: &Value) -> f64 {
 /// `x` for each of `paper-v10`'s sources, as the report has them.
 fn scales(x: f64) -> Value {
     serde_json::json!(vec![x; PAPER_SOURCES])
-}
-
-fn args(words: &[&str], json: &Path) -> Vec<String> {
-    let mut v: Vec<String> = words.iter().map(|&w| w.to_owned()).collect();
-    v.push("--json".into());
-    v.push(json.display().to_string());
-    v
 }
 
 /// A world whose every source is silenced sees no target at any step,
