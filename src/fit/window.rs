@@ -291,8 +291,12 @@ impl FitWindow {
         for (i, step) in req.steps.iter().enumerate() {
             let field = format!("steps[{i}]");
             if let Some(n) = &step.step {
-                let n = n.get().ok_or_else(|| {
-                    ValidationError::new(format!("{field}.step"), "must be a whole number ≥ 0")
+                // The document says int64.
+                let n = n.get().filter(|&n| n <= i64::MAX as u64).ok_or_else(|| {
+                    ValidationError::new(
+                        format!("{field}.step"),
+                        format!("must be a whole number in 0..={}", i64::MAX),
+                    )
                 })?;
                 if let Some(prev) = number
                     && Some(n) != prev.checked_add(1)

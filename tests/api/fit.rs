@@ -122,6 +122,9 @@ async fn bad_windows_are_refused_naming_the_field() {
     order["steps"][0]["step"] = json!(9);
     order["steps"][1]["step"] = json!(7);
     assert_validation(app.post_json(url, &order).await, "steps[1].step").await;
+    let mut huge = fit_request();
+    huge["steps"][0]["step"] = json!(9_223_372_036_854_775_808u64);
+    assert_validation(app.post_json(url, &huge).await, "steps[0].step").await;
     let mut ty = fit_request();
     ty["steps"][0]["sensors"][0]["type"] = json!("blimp");
     assert_validation(app.post_json(url, &ty).await, "steps[0].sensors[0].type").await;
