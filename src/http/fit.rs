@@ -29,8 +29,16 @@ async fn fit_admitted(
     planner: Arc<Planner>,
     req: FitRequest,
 ) -> Result<(FitResponse, FitWindow), ApiError> {
-    let window = FitWindow::new(&planner.scenario, &req)?;
-    let crossings = WindowLooks::new(&planner.scenario, &window.looks).work();
+    // A window of 500 steps takes milliseconds to check and to size: off
+    // the async workers.
+    let checked = planner.clone();
+    let (window, crossings) = tokio::task::spawn_blocking(move || {
+        let s = &checked.scenario;
+        let window = FitWindow::new(s, &req)?;
+        let crossings = WindowLooks::new(s, &window.looks).work();
+        Ok::<_, ApiError>((window, crossings))
+    })
+    .await??;
     refuse_if_costly(state, cost::fit_ms(&planner.scenario, crossings))?;
     let guard = CancelOnDrop::new("fit", start, state);
     let res = super::queue::on_rayon(move || {
