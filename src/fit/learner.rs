@@ -47,7 +47,8 @@ pub struct RateLearner {
 pub struct LearntStep {
     observed: Observed,
     exposure: Vec<f64>,
-    attribution: Attribution,
+    /// This step's new targets, attributed.
+    added: Attribution,
     rates: Vec<SourceRate>,
     planner: Option<Arc<Planner>>,
 }
@@ -170,14 +171,16 @@ impl RateLearner {
             .zip(&added)
             .map(|(a, b)| a + b)
             .collect();
-        let mut attribution = self.attribution.clone();
-        attribution.add(s, &observed.firsts, &self.tolerances.traceback);
-        let rates = attribution.rates(s, &exposure, Prior::Scenario);
+        let mut added = Attribution::new(s);
+        added.add(s, &observed.firsts, &self.tolerances.traceback);
+        let rates = self
+            .attribution
+            .rates_with(&added, s, &exposure, Prior::Scenario);
         let planner = self.replan(&rates);
         Ok(LearntStep {
             observed,
             exposure,
-            attribution,
+            added,
             rates,
             planner,
         })
@@ -211,7 +214,7 @@ impl RateLearner {
             self.recent.pop_front();
         }
         self.exposure = step.exposure;
-        self.attribution = step.attribution;
+        self.attribution.extend(step.added);
         if let Some(planner) = step.planner {
             self.planner = planner;
         }

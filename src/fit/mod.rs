@@ -67,24 +67,69 @@ impl Attribution {
 
     /// Each source's fitted rate, given its exposure and prior.
     pub fn rates(&self, s: &Scenario, exposure: &[f64], prior: Prior) -> Vec<SourceRate> {
-        let priors: Vec<Posterior> = (0..s.sources.len())
-            .map(|j| Posterior::prior(s, j, prior))
-            .collect();
-        let fallback: Vec<f64> = s.sources.iter().map(|src| src.rate).collect();
-        let (posteriors, detected) =
-            posterior::solve(&priors, exposure, &self.own, &self.shared, &fallback);
-        posteriors
-            .iter()
-            .enumerate()
-            .map(|(j, p)| SourceRate {
-                index: j,
-                rate: p.mean().unwrap_or(fallback[j]),
-                interval: p.interval(),
-                detected: detected[j],
-                exposure: exposure[j],
-            })
-            .collect()
+        let shared: Vec<&[(usize, f64)]> = self.shared.iter().map(Vec::as_slice).collect();
+        rates_of(s, &self.own, &shared, exposure, prior)
     }
+
+    /// The rates after `added` too (a step not yet recorded), without
+    /// copying this attribution.
+    pub fn rates_with(
+        &self,
+        added: &Attribution,
+        s: &Scenario,
+        exposure: &[f64],
+        prior: Prior,
+    ) -> Vec<SourceRate> {
+        let own: Vec<f64> = self
+            .own
+            .iter()
+            .zip(&added.own)
+            .map(|(a, b)| a + b)
+            .collect();
+        let shared: Vec<&[(usize, f64)]> = self
+            .shared
+            .iter()
+            .chain(&added.shared)
+            .map(Vec::as_slice)
+            .collect();
+        rates_of(s, &own, &shared, exposure, prior)
+    }
+
+    /// Records `added`.
+    pub fn extend(&mut self, added: Attribution) {
+        for (a, b) in self.own.iter_mut().zip(&added.own) {
+            *a += b;
+        }
+        self.shared.extend(added.shared);
+        self.unexplained.extend(added.unexplained);
+    }
+}
+
+/// Each source's fitted rate from its detections (`own`, and `shared`
+/// with other sources), its exposure and prior.
+fn rates_of(
+    s: &Scenario,
+    own: &[f64],
+    shared: &[&[(usize, f64)]],
+    exposure: &[f64],
+    prior: Prior,
+) -> Vec<SourceRate> {
+    let priors: Vec<Posterior> = (0..s.sources.len())
+        .map(|j| Posterior::prior(s, j, prior))
+        .collect();
+    let fallback: Vec<f64> = s.sources.iter().map(|src| src.rate).collect();
+    let (posteriors, detected) = posterior::solve(&priors, exposure, own, shared, &fallback);
+    posteriors
+        .iter()
+        .enumerate()
+        .map(|(j, p)| SourceRate {
+            index: j,
+            rate: p.mean().unwrap_or(fallback[j]),
+            interval: p.interval(),
+            detected: detected[j],
+            exposure: exposure[j],
+        })
+        .collect()
 }
 
 /// The rates that a window's observations support.

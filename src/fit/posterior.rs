@@ -107,7 +107,7 @@ pub fn solve(
     priors: &[Posterior],
     exposure: &[f64],
     own: &[f64],
-    shared: &[Vec<(usize, f64)>],
+    shared: &[&[(usize, f64)]],
     fallback: &[f64],
 ) -> (Vec<Posterior>, Vec<f64>) {
     let n = priors.len();
