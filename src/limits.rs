@@ -73,6 +73,9 @@ pub const MAX_SENSORS: usize = 256;
 pub const MAX_TARGETS: usize = 20_000;
 /// Most steps of history.
 pub const MAX_HISTORY_STEPS: usize = 32;
+
+/// Most characters of a session step's `Idempotency-Key` header.
+pub const MAX_IDEMPOTENCY_KEY_CHARS: usize = 128;
 /// Most positions in one history step.
 pub const MAX_HISTORY_POSITIONS: usize = 256;
 /// Steps of history a session keeps by default.

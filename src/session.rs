@@ -282,6 +282,41 @@ pub struct Session {
     learner: Option<Arc<RateLearner>>,
 }
 
+/// What a session holds apart from its planner: what one replica stores
+/// for another to carry the session on ([`Session::snapshot`],
+/// [`Session::restore`]). Encoded as CBOR, which keeps every `f64` to the
+/// bit, so a restored session plans exactly as the one it was taken from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Snapshot {
+    settings: SessionSettings,
+    history_len: usize,
+    step: u64,
+    history: VecDeque<Vec<PositionIn>>,
+    tracks: Vec<Track>,
+}
+
+impl Snapshot {
+    /// The version of the encoding [`Snapshot::encode`] writes; a stored
+    /// snapshot of another version is not read.
+    pub const FORMAT: i32 = 1;
+
+    /// The snapshot as bytes.
+    pub fn encode(&self) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        ciborium::into_writer(self, &mut bytes)
+            .unwrap_or_else(|e| unreachable!("a snapshot encodes to memory: {e}"));
+        bytes
+    }
+
+    /// A snapshot from [`Snapshot::encode`]'s bytes.
+    ///
+    /// # Errors
+    /// A message when the bytes are not a snapshot.
+    pub fn decode(bytes: &[u8]) -> Result<Self, String> {
+        ciborium::from_reader(bytes).map_err(|e| format!("not a session snapshot: {e}"))
+    }
+}
+
 impl Session {
     /// A session at step 0 with no history and no tracks. `settings` must
     /// have passed [`SessionSettings::history_len`] (an out-of-bounds
@@ -310,6 +345,30 @@ impl Session {
             tracks: Vec::new(),
             learner,
         }
+    }
+
+    /// Its state, less its planner.
+    pub fn snapshot(&self) -> Snapshot {
+        Snapshot {
+            settings: self.settings.clone(),
+            history_len: self.history_len,
+            step: self.step,
+            history: self.history.clone(),
+            tracks: self.tracks.clone(),
+        }
+    }
+
+    /// The session of `snapshot` on `planner`, its scenario's. A snapshot
+    /// holds no learnt rates: a store of snapshots refuses sessions that
+    /// learn them.
+    pub fn restore(planner: Arc<Planner>, snapshot: Snapshot) -> Self {
+        let mut session = Session::new(planner, snapshot.settings);
+        session.history_len = snapshot.history_len.min(MAX_HISTORY_STEPS);
+        session.step = snapshot.step;
+        session.history = snapshot.history;
+        session.history.truncate(session.history_len);
+        session.tracks = snapshot.tracks;
+        session
     }
 
     /// With `learn_rates`: its learnt rates.
@@ -574,6 +633,23 @@ mod tests {
         assert_eq!(e.field, "detections[0].y");
         req.detections = vec![anonymous(1.0, 1.0, 0.0); MAX_TARGETS + 1];
         assert_eq!(req.check().unwrap_err().field, "detections");
+    }
+
+    #[test]
+    fn a_snapshot_restores_the_session_to_the_bit() {
+        let mut s = session(3);
+        for k in 0..5 {
+            let x = 100.0 / 3.0 + f64::from(k) * 0.1;
+            s.commit(s.prepare(&step(vec![anonymous(x, 1.0 / 7.0, 0.3)])));
+        }
+        let bytes = s.snapshot().encode();
+        let back = Snapshot::decode(&bytes).unwrap();
+        assert_eq!(back, s.snapshot());
+        let restored = Session::restore(s.planner().clone(), back);
+        let next = step(vec![anonymous(10.0, 20.0, 1.0)]);
+        assert_eq!(restored.prepare(&next).request, s.prepare(&next).request);
+        assert_eq!(restored.step(), 5);
+        assert!(Snapshot::decode(&bytes[..bytes.len() / 2]).is_err());
     }
 
     #[test]

@@ -110,6 +110,10 @@ pub struct Config {
     /// dropped.
     #[arg(long, env = "VIGIL_MAX_SESSIONS", default_value_t = Settings::DEFAULT.max_sessions)]
     pub max_sessions: usize,
+    /// With a database: most megabytes of sessions this replica caches (the
+    /// sessions themselves are in the database).
+    #[arg(long, env = "VIGIL_SESSION_CACHE_MB", default_value_t = (Settings::DEFAULT.session_cache_bytes >> 20) as u64)]
+    pub session_cache_mb: u64,
 }
 
 impl Config {
@@ -158,6 +162,8 @@ pub struct Settings {
     pub session_ttl: Duration,
     /// Most sessions held at once.
     pub max_sessions: usize,
+    /// With a database: most bytes of sessions cached by this replica.
+    pub session_cache_bytes: usize,
     /// Whether plans predicted under [`INLINE_PLAN_MS`] run on the async
     /// worker that received them instead of on rayon's pool; `None`: when
     /// the pool has one thread (one core), where the hop to it and back is
@@ -208,6 +214,7 @@ impl Settings {
         max_plan_ms: Some(DEFAULT_MAX_PLAN_MS as f64),
         session_ttl: Duration::from_secs(600),
         max_sessions: 10_000,
+        session_cache_bytes: 256 << 20,
         inline_plans: None,
     };
 }
@@ -237,6 +244,8 @@ impl From<&Config> for Settings {
             max_plan_ms: (c.max_plan_ms > 0).then_some(c.max_plan_ms as f64),
             session_ttl: Duration::from_secs(c.session_ttl_s.max(1)),
             max_sessions: c.max_sessions.max(1),
+            session_cache_bytes: usize::try_from(c.session_cache_mb.saturating_mul(1 << 20))
+                .unwrap_or(usize::MAX),
             inline_plans: None,
         }
     }

@@ -89,6 +89,16 @@ pub enum ApiError {
         /// The sessions' idle time to live, seconds.
         ttl_s: u64,
     },
+    /// Another step of the session was stored while this one was made, and
+    /// making it again from that step's state kept losing the race. 409.
+    #[error(
+        "session `{0}` was stepped by other requests while this step was made, and again each time it was made anew; send it again (with the same Idempotency-Key, a step already made is answered, not made twice)"
+    )]
+    SessionConflict(String),
+    /// A request header is not acceptable (e.g. an `Idempotency-Key` over
+    /// its length). 400.
+    #[error("{0}")]
+    BadHeader(String),
     /// The scenario is still being precomputed. 503 with Retry-After.
     #[error("scenario `{id}` is still {}; retry in about {} s", if status.queue_position.is_some() { "queued for precomputation" } else { "precomputing" }, status.retry_after_s())]
     ScenarioNotReady {
@@ -169,9 +179,9 @@ impl ApiError {
             | ApiError::SessionNotFound { .. }
             | ApiError::RouteNotFound(_)
             | ApiError::SensorTypeNotFound { .. } => StatusCode::NOT_FOUND,
-            ApiError::BadQuery(_) => StatusCode::BAD_REQUEST,
+            ApiError::BadQuery(_) | ApiError::BadHeader(_) => StatusCode::BAD_REQUEST,
             ApiError::MethodNotAllowed { .. } => StatusCode::METHOD_NOT_ALLOWED,
-            ApiError::BuiltinScenario(_) => StatusCode::CONFLICT,
+            ApiError::BuiltinScenario(_) | ApiError::SessionConflict(_) => StatusCode::CONFLICT,
             ApiError::Validation(_) => StatusCode::UNPROCESSABLE_ENTITY,
             ApiError::Unauthorized => StatusCode::UNAUTHORIZED,
             ApiError::Overloaded => StatusCode::SERVICE_UNAVAILABLE,
@@ -206,6 +216,10 @@ impl ApiError {
             ApiError::Timeout => ("timeout", "Request timed out"),
             ApiError::Unprocessable(_) => ("validation", "Invalid request"),
             ApiError::SessionNotFound { .. } => ("session-not-found", "Session not found"),
+            ApiError::SessionConflict(_) => {
+                ("session-step-conflict", "Session stepped concurrently")
+            }
+            ApiError::BadHeader(_) => ("bad-header", "Bad header"),
             ApiError::ScenarioNotReady { .. } => ("scenario-not-ready", "Scenario not ready"),
             ApiError::QueueFull { .. } => ("precompute-queue-full", "Precompute queue full"),
             ApiError::PlanTooCostly { .. } => ("plan-too-costly", "Plan too costly"),
@@ -338,5 +352,13 @@ impl From<CatalogError> for ApiError {
             CatalogError::Internal(message) => ApiError::Internal(message),
             CatalogError::DatabaseUnavailable => ApiError::DatabaseUnavailable,
         }
+    }
+}
+
+impl From<crate::store::DbError> for ApiError {
+    /// Logs the database's error here: the client is only told to retry.
+    fn from(e: crate::store::DbError) -> Self {
+        tracing::warn!(error = %e, "the database is unavailable");
+        ApiError::DatabaseUnavailable
     }
 }

@@ -19,8 +19,8 @@ use super::doc::bounds::Bounds;
 use super::doc::{
     BadPath, BuiltinScenario, InvalidEvaluateRequest, InvalidFitRequest,
     InvalidInlineEvaluateRequest, InvalidInlinePlanRequest, InvalidPlanRequest, InvalidScenario,
-    InvalidSession, MalformedBody, NotReady, Overloaded, PayloadTooLarge, QueueFull,
-    ScenarioNotFound, SessionNotFound, Timeout, Unauthorized,
+    InvalidSession, MalformedBody, MalformedStep, NotReady, Overloaded, PayloadTooLarge, QueueFull,
+    ScenarioNotFound, SessionConflict, SessionNotFound, Timeout, Unauthorized,
 };
 use super::error::Problem;
 use super::{evaluate, fit, health, middleware, plan, scenarios, sessions};
@@ -86,6 +86,8 @@ Every error is an RFC 9457 problem (`application/problem+json`, schema \
             InvalidFitRequest,
             InvalidSession,
             SessionNotFound,
+            MalformedStep,
+            SessionConflict,
             Unauthorized,
             Overloaded,
             NotReady,

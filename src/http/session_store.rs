@@ -1,35 +1,106 @@
-//! The sessions of this replica, in memory: bounded by an idle time to live
-//! and a count, the least recently used evicted first; expired sessions are
-//! dropped at the next session request.
+//! Where sessions are kept, one of two ways chosen at start-up:
+//! - **In this replica's memory** (no database): an LRU map bounded by an
+//!   idle time to live and a count, the least recently used evicted first;
+//!   expired sessions are dropped at the next session request.
+//! - **In the database** (`--database-url`, [`crate::store::sessions`]):
+//!   every replica serves every session. This replica's memory holds only
+//!   a cache of sessions it served, bounded in bytes; a step checks its
+//!   cached state against the row's version and reloads it when another
+//!   replica moved it on, and is acknowledged only once stored over the
+//!   version it was made from ([`SessionStore::save`]).
+//!
+//! Either way a step answered for an `Idempotency-Key` is answered again,
+//! unchanged, to a retry with that key ([`Refreshed::Replay`]).
 
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
+use axum::body::Bytes;
 use lru::LruCache;
 
 use super::error::ApiError;
 use crate::metric_names;
-use crate::session::Session;
+use crate::planner::Planner;
+use crate::session::{Session, Snapshot};
+use crate::store::PgStore;
+use crate::store::sessions::NewSession;
 
-/// A session shared by its requests; its steps run one at a time.
-pub type Shared = Arc<tokio::sync::Mutex<Session>>;
+/// A session shared by its requests on this replica; its steps here run
+/// one at a time.
+pub type Shared = Arc<tokio::sync::Mutex<Held>>;
 
-/// The sessions of this replica: an LRU map bounded by count and idle time.
+/// A session as this replica holds it.
+#[derive(Debug, Default)]
+pub struct Held {
+    /// The state, once loaded.
+    session: Option<Session>,
+    /// Steps stored (in the database: the row's version this state is).
+    version: i64,
+    /// The state may differ from the stored one (a step made here was not
+    /// stored): reload it whatever the version.
+    stale: bool,
+    /// In memory: the last step's Idempotency-Key and answer.
+    last: Option<(String, Bytes)>,
+}
+
+/// What a step or a read finds ([`SessionStore::refresh`]).
+#[derive(Debug)]
+pub enum Refreshed<'a> {
+    /// The session, current.
+    Session(&'a mut Session),
+    /// The answer already given to this Idempotency-Key.
+    Replay(Bytes),
+}
+
+/// A cached session and what it costs.
+#[derive(Debug)]
+struct Entry {
+    held: Shared,
+    used: Instant,
+    bytes: usize,
+}
+
+#[derive(Debug)]
+struct Map {
+    lru: LruCache<String, Entry>,
+    bytes: usize,
+}
+
+/// The sessions (see the module docs).
 #[derive(Debug)]
 pub struct SessionStore {
-    inner: Mutex<LruCache<String, (Shared, Instant)>>,
+    map: Mutex<Map>,
     ttl: Duration,
     capacity: usize,
+    /// With a database: the cache's bound, bytes.
+    cache_bytes: usize,
+    db: Option<PgStore>,
 }
 
 impl SessionStore {
-    /// A store of at most `capacity` sessions, each dropped after `ttl`
+    /// Sessions in memory: at most `capacity`, each dropped after `ttl`
     /// without a request.
     pub fn new(ttl: Duration, capacity: usize) -> Self {
         Self {
-            inner: Mutex::new(LruCache::unbounded()),
+            map: Mutex::new(Map {
+                lru: LruCache::unbounded(),
+                bytes: 0,
+            }),
             ttl,
             capacity: capacity.max(1),
+            cache_bytes: usize::MAX,
+            db: None,
+        }
+    }
+
+    /// Sessions in database `db` (at most `capacity`, each dropped after
+    /// `ttl` without a request), with a cache here of at most
+    /// `cache_bytes`.
+    pub fn with_database(ttl: Duration, capacity: usize, cache_bytes: usize, db: PgStore) -> Self {
+        Self {
+            cache_bytes,
+            db: Some(db),
+            ..Self::new(ttl, capacity)
         }
     }
 
@@ -38,71 +109,325 @@ impl SessionStore {
         self.ttl
     }
 
-    fn lock(&self) -> std::sync::MutexGuard<'_, LruCache<String, (Shared, Instant)>> {
-        // Every critical section is a single map operation: poisoning
-        // cannot leave it half-updated.
-        self.inner.lock().unwrap_or_else(PoisonError::into_inner)
+    /// Whether sessions are kept in the database.
+    pub fn in_database(&self) -> bool {
+        self.db.is_some()
     }
 
-    /// Drops the sessions idle longer than the time to live: the least
-    /// recently used come first, so only the expired are visited.
-    fn sweep(&self, map: &mut LruCache<String, (Shared, Instant)>, now: Instant) {
-        while let Some((_, (_, used))) = map.peek_lru() {
-            if now.duration_since(*used) <= self.ttl {
+    fn lock(&self) -> std::sync::MutexGuard<'_, Map> {
+        // Every critical section is a few map operations that cannot fail
+        // half-way: poisoning cannot leave it inconsistent.
+        self.map.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    /// In memory: drops the sessions idle longer than the time to live
+    /// (the least recently used come first, so only the expired are
+    /// visited).
+    fn sweep(&self, map: &mut Map, now: Instant) {
+        if self.db.is_some() {
+            return;
+        }
+        while let Some((_, entry)) = map.lru.peek_lru() {
+            if now.duration_since(entry.used) <= self.ttl {
                 break;
             }
-            map.pop_lru();
+            if let Some((_, gone)) = map.lru.pop_lru() {
+                map.bytes -= gone.bytes;
+            }
             metrics::counter!(metric_names::SESSIONS_EVICTED_TOTAL, "reason" => "idle")
                 .increment(1);
         }
-        metrics::gauge!(metric_names::SESSIONS_LIVE).set(map.len() as f64);
+        metrics::gauge!(metric_names::SESSIONS_LIVE).set(map.lru.len() as f64);
     }
 
-    /// Keeps a new session under a fresh id, evicting the least recently
-    /// used past the capacity.
-    pub fn insert(&self, session: Session) -> (String, Shared) {
-        let id = format!("ss-{}", uuid::Uuid::new_v4().simple());
-        let shared = Arc::new(tokio::sync::Mutex::new(session));
+    /// Puts `held` in the map, evicting past the count (in memory) or past
+    /// the byte budget (a cache).
+    fn put(&self, id: &str, held: Shared, bytes: usize) {
         let now = Instant::now();
         let mut map = self.lock();
         self.sweep(&mut map, now);
-        while map.len() >= self.capacity {
-            map.pop_lru();
-            metrics::counter!(metric_names::SESSIONS_EVICTED_TOTAL, "reason" => "capacity")
-                .increment(1);
+        if let Some(old) = map.lru.put(
+            id.to_owned(),
+            Entry {
+                held,
+                used: now,
+                bytes,
+            },
+        ) {
+            map.bytes -= old.bytes;
         }
-        map.put(id.clone(), (shared.clone(), now));
-        metrics::gauge!(metric_names::SESSIONS_LIVE).set(map.len() as f64);
-        (id, shared)
+        map.bytes += bytes;
+        while map.lru.len() > 1
+            && (if self.db.is_some() {
+                map.bytes > self.cache_bytes
+            } else {
+                map.lru.len() > self.capacity
+            })
+        {
+            let Some((_, gone)) = map.lru.pop_lru() else {
+                break;
+            };
+            map.bytes -= gone.bytes;
+            if self.db.is_none() {
+                metrics::counter!(metric_names::SESSIONS_EVICTED_TOTAL, "reason" => "capacity")
+                    .increment(1);
+            }
+        }
+        if self.db.is_none() {
+            metrics::gauge!(metric_names::SESSIONS_LIVE).set(map.lru.len() as f64);
+        }
     }
 
-    /// A live session, marked as used now.
+    /// Updates what the cached session `id` costs, if it is cached.
+    fn resize(&self, id: &str, bytes: usize) {
+        let mut map = self.lock();
+        let Some(entry) = map.lru.peek_mut(id) else {
+            return;
+        };
+        let old = std::mem::replace(&mut entry.bytes, bytes);
+        map.bytes = map.bytes - old + bytes;
+    }
+
+    fn forget(&self, id: &str) {
+        let mut map = self.lock();
+        if let Some(gone) = map.lru.pop(id) {
+            map.bytes -= gone.bytes;
+        }
+        if self.db.is_none() {
+            metrics::gauge!(metric_names::SESSIONS_LIVE).set(map.lru.len() as f64);
+        }
+    }
+
+    /// Keeps a new session under a fresh id (in the database, stored
+    /// first), evicting the least recently used past the count.
     ///
     /// # Errors
-    /// [`ApiError::SessionNotFound`] for an unknown, expired or evicted id.
-    pub fn get(&self, id: &str) -> Result<Shared, ApiError> {
+    /// [`ApiError::DatabaseUnavailable`] if the database cannot store it.
+    pub async fn create(&self, session: Session) -> Result<(String, Shared), ApiError> {
+        let id = format!("ss-{}", uuid::Uuid::new_v4().simple());
+        if let Some(db) = &self.db {
+            let snapshot = session.snapshot();
+            let spec = encode_spec(session.planner())?;
+            let made = db
+                .create_session(
+                    NewSession {
+                        id: &id,
+                        scenario_id: &session.planner().scenario.id,
+                        spec: &spec,
+                        format: Snapshot::FORMAT,
+                        state: &snapshot.encode(),
+                    },
+                    self.ttl,
+                    self.capacity,
+                )
+                .await?;
+            for (reason, n) in [("idle", made.idle), ("capacity", made.capacity)] {
+                metrics::counter!(metric_names::SESSIONS_EVICTED_TOTAL, "reason" => reason)
+                    .increment(n);
+            }
+            metrics::gauge!(metric_names::SESSIONS_LIVE).set(made.live as f64);
+        }
+        let bytes = session.memory_bytes();
+        let held = Arc::new(tokio::sync::Mutex::new(Held {
+            session: Some(session),
+            ..Held::default()
+        }));
+        self.put(&id, held.clone(), bytes);
+        Ok((id, held))
+    }
+
+    /// Session `id` as this replica holds it, marked as used now: in
+    /// memory, the session itself; in the database, its cached state, or
+    /// a place to load it into ([`SessionStore::refresh`] makes it
+    /// current).
+    ///
+    /// # Errors
+    /// [`ApiError::SessionNotFound`] in memory for an unknown, expired or
+    /// evicted id.
+    pub fn checkout(&self, id: &str) -> Result<Shared, ApiError> {
         let now = Instant::now();
         let mut map = self.lock();
         self.sweep(&mut map, now);
-        match map.get_mut(id) {
-            Some((session, used)) => {
-                *used = now;
-                Ok(session.clone())
+        if let Some(entry) = map.lru.get_mut(id) {
+            entry.used = now;
+            return Ok(entry.held.clone());
+        }
+        if self.db.is_none() {
+            return Err(self.not_found(id));
+        }
+        drop(map);
+        let held = Shared::default();
+        self.put(id, held.clone(), 0);
+        Ok(held)
+    }
+
+    /// Makes `held` (session `id`'s, from [`SessionStore::checkout`])
+    /// current: in the database, reloads its state if the row moved on
+    /// (building its planner with `resolve`, of the scenario's id and its
+    /// spec, if nothing is loaded yet). With `key`, the answer to the last
+    /// step if it was made for that Idempotency-Key. With `touch`, marks
+    /// the session used now in the database.
+    ///
+    /// # Errors
+    /// [`ApiError::SessionNotFound`] if the session is not live;
+    /// [`ApiError::DatabaseUnavailable`]; `resolve`'s errors; an internal
+    /// error for a stored session this server cannot read.
+    pub async fn refresh<'a>(
+        &self,
+        id: &str,
+        held: &'a mut Held,
+        key: Option<&str>,
+        touch: bool,
+        resolve: impl AsyncFnOnce(String, Vec<u8>) -> Result<Arc<Planner>, ApiError>,
+    ) -> Result<Refreshed<'a>, ApiError> {
+        let Some(db) = &self.db else {
+            if let (Some(key), Some((last, answer))) = (key, &held.last)
+                && key == last
+            {
+                return Ok(Refreshed::Replay(answer.clone()));
             }
-            None => Err(self.not_found(id)),
+            return match &mut held.session {
+                Some(session) => Ok(Refreshed::Session(session)),
+                None => Err(self.not_found(id)),
+            };
+        };
+        let have = (!held.stale && held.session.is_some()).then_some(held.version);
+        let row = db
+            .load_session(id, self.ttl, have, held.session.is_none(), key, touch)
+            .await?;
+        let Some(row) = row else {
+            self.forget(id);
+            if db.drop_expired_session(id, self.ttl).await.unwrap_or(false) {
+                metrics::counter!(metric_names::SESSIONS_EVICTED_TOTAL, "reason" => "idle")
+                    .increment(1);
+            }
+            return Err(self.not_found(id));
+        };
+        if let Some(answer) = row.replay {
+            return Ok(Refreshed::Replay(Bytes::from(answer)));
+        }
+        if let Some(state) = row.state {
+            let snapshot = if row.format == Snapshot::FORMAT {
+                Snapshot::decode(&state)
+            } else {
+                Err(format!(
+                    "format {} (this server reads {})",
+                    row.format,
+                    Snapshot::FORMAT
+                ))
+            }
+            .map_err(|reason| {
+                tracing::error!(%id, %reason, "a stored session cannot be read");
+                ApiError::Internal(format!("stored session {id} cannot be read: {reason}"))
+            })?;
+            let planner = match (&held.session, row.spec) {
+                (Some(session), _) => session.planner().clone(),
+                (None, Some(spec)) => resolve(row.scenario_id, spec).await?,
+                (None, None) => {
+                    return Err(ApiError::Internal(format!(
+                        "session {id}: its spec was not loaded"
+                    )));
+                }
+            };
+            let session = Session::restore(planner, snapshot);
+            self.resize(id, session.memory_bytes());
+            held.session = Some(session);
+        }
+        held.version = row.version;
+        held.stale = false;
+        match &mut held.session {
+            Some(session) => Ok(Refreshed::Session(session)),
+            None => Err(ApiError::Internal(format!("session {id} was not loaded"))),
+        }
+    }
+
+    /// Records a step made on `held` (session `id`'s, made current by
+    /// [`SessionStore::refresh`]) and answered `answer`: in the database,
+    /// stores it over the version it was made from. False if another step
+    /// was stored first (or the session expired): `held` is then reloaded
+    /// at the next [`SessionStore::refresh`] and the step must be made
+    /// again.
+    ///
+    /// # Errors
+    /// [`ApiError::DatabaseUnavailable`] (the step may have been stored or
+    /// not; `held` is reloaded at the next refresh).
+    pub async fn save(
+        &self,
+        id: &str,
+        held: &mut Held,
+        key: Option<&str>,
+        answer: &Bytes,
+    ) -> Result<bool, ApiError> {
+        let Some(session) = &held.session else {
+            return Err(ApiError::Internal(format!("session {id} was not loaded")));
+        };
+        let bytes = session.memory_bytes();
+        let Some(db) = &self.db else {
+            held.last = key.map(|k| (k.to_owned(), answer.clone()));
+            held.version += 1;
+            self.resize(id, bytes + answer.len());
+            return Ok(true);
+        };
+        // Until it is known to be stored, this state is not the stored one.
+        held.stale = true;
+        let state = session.snapshot().encode();
+        let stored = db
+            .save_session(
+                id,
+                self.ttl,
+                held.version,
+                Snapshot::FORMAT,
+                &state,
+                key,
+                answer,
+            )
+            .await?;
+        if stored {
+            held.version += 1;
+            held.stale = false;
+            self.resize(id, bytes);
+        }
+        Ok(stored)
+    }
+
+    /// Marks session `id` used now (after a step that failed, which
+    /// stored nothing), in the background; nothing to do in memory.
+    pub fn touch(&self, id: &str) {
+        if let Some(db) = self.db.clone() {
+            let (id, ttl) = (id.to_owned(), self.ttl);
+            tokio::spawn(async move {
+                let _ = db.touch_session(&id, ttl).await;
+            });
         }
     }
 
     /// Removes a session.
     ///
     /// # Errors
-    /// [`ApiError::SessionNotFound`] for an unknown, expired or evicted id.
-    pub fn remove(&self, id: &str) -> Result<(), ApiError> {
-        let mut map = self.lock();
-        self.sweep(&mut map, Instant::now());
-        let removed = map.pop(id).map(|_| ()).ok_or_else(|| self.not_found(id));
-        metrics::gauge!(metric_names::SESSIONS_LIVE).set(map.len() as f64);
-        removed
+    /// [`ApiError::SessionNotFound`] for an unknown, expired or evicted id;
+    /// [`ApiError::DatabaseUnavailable`].
+    pub async fn remove(&self, id: &str) -> Result<(), ApiError> {
+        let Some(db) = &self.db else {
+            let mut map = self.lock();
+            self.sweep(&mut map, Instant::now());
+            let removed = map.lru.pop(id);
+            if let Some(gone) = &removed {
+                map.bytes -= gone.bytes;
+            }
+            metrics::gauge!(metric_names::SESSIONS_LIVE).set(map.lru.len() as f64);
+            return removed.map(|_| ()).ok_or_else(|| self.not_found(id));
+        };
+        let deleted = db.delete_session(id, self.ttl).await?;
+        self.forget(id);
+        match deleted {
+            Some(true) => Ok(()),
+            Some(false) => {
+                metrics::counter!(metric_names::SESSIONS_EVICTED_TOTAL, "reason" => "idle")
+                    .increment(1);
+                Err(self.not_found(id))
+            }
+            None => Err(self.not_found(id)),
+        }
     }
 
     fn not_found(&self, id: &str) -> ApiError {
@@ -111,4 +436,13 @@ impl SessionStore {
             ttl_s: self.ttl.as_secs(),
         }
     }
+}
+
+/// A scenario's spec as a session row keeps it (CBOR: every number to the
+/// bit, so the spec rebuilds the same scenario and id).
+fn encode_spec(planner: &Planner) -> Result<Vec<u8>, ApiError> {
+    let mut bytes = Vec::new();
+    ciborium::into_writer(&planner.scenario.spec, &mut bytes)
+        .map_err(|e| ApiError::Internal(format!("encoding a scenario's spec: {e}")))?;
+    Ok(bytes)
 }

@@ -2,15 +2,19 @@
 //! history and tracks ([`crate::session`]); each step sends only the
 //! sensors now and the detections now.
 //!
-//! Sessions live in this replica's memory, bounded by an idle time to live
-//! and a count (least recently used evicted first); expired sessions are
-//! dropped at the next session request. Steps of one session run one at a
-//! time, in arrival order.
+//! Sessions are kept by a [`super::session_store::SessionStore`]: in this
+//! replica's memory, or in the database shared by every replica. Steps of
+//! one session run one at a time on a replica; across replicas, a step is
+//! stored only over the state it was made from, and made again (up to
+//! [`STEP_ATTEMPTS`] times, then 409) when another step was stored first.
 
 use axum::Extension;
+use axum::body::Bytes;
 use axum::extract::State;
-use axum::http::{HeaderValue, StatusCode, header};
+use axum::http::{HeaderMap, HeaderValue, StatusCode, header};
 use axum::response::{IntoResponse, Response};
+use std::sync::Arc;
+
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
@@ -19,12 +23,13 @@ use super::error::ApiError;
 use super::extract::{Json, Path, QueuedJson};
 use super::middleware::RequestStart;
 use super::planning::{plan_admitted, resolve_scenario};
+use super::session_store::Refreshed;
 use super::state::AppState;
 use crate::catalog::predicted_precompute_ms;
 use crate::fit::SourceRate;
-use crate::limits::{MAX_HORIZON, MAX_MIN_SEPARATION, MAX_TARGETS};
-use crate::planner::{PlanResponse, check_estimator};
-use crate::scenario::ValidationError;
+use crate::limits::{MAX_HORIZON, MAX_IDEMPOTENCY_KEY_CHARS, MAX_MIN_SEPARATION, MAX_TARGETS};
+use crate::planner::{PlanResponse, Planner, check_estimator};
+use crate::scenario::{ScenarioSpec, ValidationError};
 use crate::session::{Session, SessionSettings, StepRequest, Track};
 
 /// A session, as `POST /v1/sessions` and `GET /v1/sessions/{id}` return it.
@@ -95,9 +100,10 @@ pub struct StepResponse {
         now and the targets detected now. The body names the scenario (`scenario_id`, or an \
         inline `scenario` as in `POST /v1/plan`) and the defaults of its steps; \
         `history_steps` (0..=32, 16 by default) is how many steps of history it keeps. \
-        Sessions live in this replica's memory: route a session's requests to the replica \
-        that created it, or use the stateless endpoints. A session idle for `--session-ttl-s` \
-        (600 s), or the least recently used past `--max-sessions` (10 000), is dropped. \
+        Without a database a session lives in the memory of the replica that created it: \
+        route its requests there. With `--database-url` it is kept in the database, and every \
+        replica on it serves it. A session idle for `--session-ttl-s` (600 s), or the least \
+        recently used past `--max-sessions` (10 000), is dropped. \
         With `learn_rates: true` the session learns the sources' rates from its detections \
         (each needs an `id`), plans with them and reports them as `rates` at every step \
         (see `docs/learning.md`); only a scenario precomputed within \
@@ -158,9 +164,20 @@ pub async fn create(
             .into());
         }
     }
+    if settings.learn_rates == Some(true) && state.sessions.in_database() {
+        return Err(ValidationError::new(
+            "learn_rates",
+            "this server keeps sessions in its database (--database-url), which does not keep a session's learnt rates yet; learn rates with POST /v1/scenarios/{id}/fit, or on a server without a database",
+        )
+        .into());
+    }
     let session = Session::new(planner, settings);
-    let (id, shared) = state.sessions.insert(session);
-    let info = SessionInfo::of(id.clone(), &*shared.lock().await);
+    let info = SessionInfo::of(String::new(), &session);
+    let (id, _) = state.sessions.create(session).await?;
+    let info = SessionInfo {
+        id: id.clone(),
+        ..info
+    };
     let location = HeaderValue::try_from(format!("/v1/sessions/{id}"))
         .map_err(|e| ApiError::Internal(format!("bad Location header: {e}")))?;
     Ok((
@@ -185,30 +202,101 @@ pub async fn create(
         from the sensors now, the tracks and the sensors' positions over the last \
         `history_steps` steps: the same plan as the stateless request of that state. Only a \
         step whose plan is made is recorded, so a step that failed (4xx, 5xx) may be sent \
-        again. Steps of one session run one at a time.", plan_rules!()),
-    params(("id" = String, Path, description = "Session id, from `POST /v1/sessions`.")),
+        again. Steps of one session run one at a time, each from the state the one before \
+        left, whichever replica serves them. A step sent with an `Idempotency-Key` header is \
+        answered, to the byte, with the first answer to that key if the session's last \
+        step had it, and is not made again: send one to retry safely after a lost answer, \
+        a timeout or a 503.", plan_rules!()),
+    params(
+        ("id" = String, Path, description = "Session id, from `POST /v1/sessions`."),
+        ("Idempotency-Key" = Option<String>, Header, description = "Any string of 1 to 128 \
+            visible ASCII characters naming this step (e.g. its number or a UUID): a retry \
+            with the key of the session's last step gets that step's answer again instead of \
+            a new step.", min_length = 1, max_length = 128,
+            pattern = r"^[\x21-\x7E]([\x20-\x7E]*[\x21-\x7E])?$"),
+    ),
     request_body(content = StepRequest, description = "Sensors and detections now.",
         example = json!(examples::step_request())),
     responses(
         (status = 200, description = "The plan of this step.", body = StepResponse,
             example = json!(examples::step_response())),
-        (status = 400, response = doc::MalformedBody),
+        (status = 400, response = doc::MalformedStep),
         (status = 404, response = doc::SessionNotFound),
+        (status = 409, response = doc::SessionConflict),
         (status = 413, response = doc::PayloadTooLarge),
         (status = 422, response = doc::InvalidPlanRequest),
+        (status = 503, response = doc::NotReady),
     )
 )]
 pub async fn step(
     State(state): State<AppState>,
     start: Option<Extension<RequestStart>>,
     Path(id): Path<String>,
+    headers: HeaderMap,
     body: Result<QueuedJson<StepRequest>, ApiError>,
-) -> Result<Json<StepResponse>, ApiError> {
-    let shared = state.sessions.get(&id)?;
+) -> Result<Response, ApiError> {
+    let shared = state.sessions.checkout(&id)?;
+    let key = idempotency_key(&headers)?;
     let QueuedJson(req) = body?;
     req.check()?;
-    let mut session = shared.lock().await;
-    let prepared = session.prepare(&req);
+    let mut held = shared.lock().await;
+    for _ in 0..STEP_ATTEMPTS {
+        let resolve = async |scenario_id, spec| stored_planner(&state, scenario_id, spec).await;
+        let session = match state
+            .sessions
+            .refresh(&id, &mut held, key, false, resolve)
+            .await?
+        {
+            Refreshed::Replay(answer) => return Ok(json_bytes(answer)),
+            Refreshed::Session(session) => session,
+        };
+        let answer = match make_step(&state, start, session, &req).await {
+            Ok(answer) => answer,
+            Err(e) => {
+                state.sessions.touch(&id);
+                return Err(e);
+            }
+        };
+        if state.sessions.save(&id, &mut held, key, &answer).await? {
+            return Ok(json_bytes(answer));
+        }
+    }
+    Err(ApiError::SessionConflict(id))
+}
+
+/// The header naming a step, so that a retry is answered, not made again.
+pub const IDEMPOTENCY_KEY: &str = "idempotency-key";
+
+/// Times a step is made anew when another step of its session was stored
+/// first, before it is refused with 409.
+pub const STEP_ATTEMPTS: usize = 3;
+
+/// The `Idempotency-Key` header, if any.
+fn idempotency_key(headers: &HeaderMap) -> Result<Option<&str>, ApiError> {
+    let Some(value) = headers.get(IDEMPOTENCY_KEY) else {
+        return Ok(None);
+    };
+    let key = value.to_str().map_err(|_| {
+        ApiError::BadHeader("Idempotency-Key: must be visible ASCII characters".into())
+    })?;
+    if key.is_empty() || key.len() > MAX_IDEMPOTENCY_KEY_CHARS {
+        return Err(ApiError::BadHeader(format!(
+            "Idempotency-Key: must have 1 to {MAX_IDEMPOTENCY_KEY_CHARS} characters, not {}",
+            key.len()
+        )));
+    }
+    Ok(Some(key))
+}
+
+/// Makes one step on `session` (changed only if its plan is made) and
+/// returns its answer, encoded.
+async fn make_step(
+    state: &AppState,
+    start: Option<Extension<RequestStart>>,
+    session: &mut Session,
+    req: &StepRequest,
+) -> Result<Bytes, ApiError> {
+    let prepared = session.prepare(req);
     if prepared.request.targets.len() > MAX_TARGETS {
         return Err(ValidationError::new(
             "detections",
@@ -230,15 +318,57 @@ pub async fn step(
         None => None,
     };
     let planner = session.planner_for(learnt.as_ref());
-    let plan = plan_admitted(&state, start, planner, &prepared.request).await?;
+    let plan = plan_admitted(state, start, planner, &prepared.request).await?;
     let step = session.step();
+    let rates = learnt.as_ref().map(|learnt| learnt.rates().to_vec());
+    let answer = serde_json::to_vec(&StepResponse { step, plan, rates })
+        .map_err(|e| ApiError::Internal(format!("encoding a step's answer: {e}")))?;
     session.commit(prepared);
-    let rates = learnt.map(|learnt| {
-        let rates = learnt.rates().to_vec();
+    if let Some(learnt) = learnt {
         session.commit_learnt(learnt);
-        rates
-    });
-    Ok(Json(StepResponse { step, plan, rates }))
+    }
+    Ok(Bytes::from(answer))
+}
+
+/// The planner of a session loaded from the database: its registered
+/// scenario's, else (an inline scenario) one built from the stored spec.
+async fn stored_planner(
+    state: &AppState,
+    scenario_id: String,
+    spec: Vec<u8>,
+) -> Result<Arc<Planner>, ApiError> {
+    let id = serde_json::Value::String(scenario_id.clone());
+    let planner = match resolve_scenario(state, None, Some(id), None).await {
+        Err(ApiError::ScenarioNotFound(_)) => {
+            let spec: ScenarioSpec = ciborium::from_reader(spec.as_slice()).map_err(|e| {
+                ApiError::Internal(format!("the stored spec of {scenario_id}: {e}"))
+            })?;
+            let spec = serde_json::to_value(spec).map_err(|e| {
+                ApiError::Internal(format!("the stored spec of {scenario_id}: {e}"))
+            })?;
+            resolve_scenario(state, None, None, Some(spec)).await?
+        }
+        other => other?,
+    };
+    if planner.scenario.id != scenario_id {
+        return Err(ApiError::Internal(format!(
+            "the stored spec of {scenario_id} makes scenario {}",
+            planner.scenario.id
+        )));
+    }
+    Ok(planner)
+}
+
+/// A JSON body already encoded.
+fn json_bytes(answer: Bytes) -> Response {
+    (
+        [(
+            header::CONTENT_TYPE,
+            HeaderValue::from_static(mime::APPLICATION_JSON.as_ref()),
+        )],
+        answer,
+    )
+        .into_response()
 }
 
 /// `GET /v1/sessions/{id}` → 200 [`SessionInfo`].
@@ -254,15 +384,24 @@ pub async fn step(
             example = json!(examples::session_info())),
         (status = 400, response = doc::BadPath),
         (status = 404, response = doc::SessionNotFound),
+        (status = 503, response = doc::NotReady),
     )
 )]
 pub async fn get(
     State(state): State<AppState>,
     Path(id): Path<String>,
 ) -> Result<Json<SessionInfo>, ApiError> {
-    let shared = state.sessions.get(&id)?;
-    let session = shared.lock().await;
-    Ok(Json(SessionInfo::of(id, &session)))
+    let shared = state.sessions.checkout(&id)?;
+    let mut held = shared.lock().await;
+    let resolve = async |scenario_id, spec| stored_planner(&state, scenario_id, spec).await;
+    match state
+        .sessions
+        .refresh(&id, &mut held, None, true, resolve)
+        .await?
+    {
+        Refreshed::Session(session) => Ok(Json(SessionInfo::of(id, session))),
+        Refreshed::Replay(_) => Err(ApiError::Internal("a read replayed a step".into())),
+    }
 }
 
 /// `DELETE /v1/sessions/{id}` → 204.
@@ -277,12 +416,13 @@ pub async fn get(
         (status = 204, description = "Closed."),
         (status = 400, response = doc::BadPath),
         (status = 404, response = doc::SessionNotFound),
+        (status = 503, response = doc::NotReady),
     )
 )]
 pub async fn delete(
     State(state): State<AppState>,
     Path(id): Path<String>,
 ) -> Result<StatusCode, ApiError> {
-    state.sessions.remove(&id)?;
+    state.sessions.remove(&id).await?;
     Ok(StatusCode::NO_CONTENT)
 }

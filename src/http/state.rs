@@ -64,12 +64,23 @@ impl AppState {
 impl AppState {
     /// State from the server's configuration with scenarios in the
     /// database `store` (connected and migrated): starts following its
-    /// deletions on the current runtime ([`Registry::watch`]).
+    /// deletions on the current runtime ([`Registry::watch`]); sessions are
+    /// kept in the database too.
     pub fn from_database(config: &Config, store: PgStore) -> Self {
         let settings = Settings::from(config);
-        let registry = Registry::with_database(store, settings.job_limits(), settings.cache_bytes);
+        let registry =
+            Registry::with_database(store.clone(), settings.job_limits(), settings.cache_bytes);
         registry.watch();
-        Self::with_settings(registry, settings)
+        let sessions = SessionStore::with_database(
+            settings.session_ttl,
+            settings.max_sessions,
+            settings.session_cache_bytes,
+            store,
+        );
+        Self {
+            sessions: Arc::new(sessions),
+            ..Self::with_settings(registry, settings)
+        }
     }
 }
 

@@ -10,11 +10,14 @@
 //!   The schema comes from the migrations under `migrations/`, applied at
 //!   start; deletions are pushed to every replica with LISTEN/NOTIFY.
 //!
+//! With a database, sessions are kept there too ([`sessions`]).
+//!
 //! Either way only the spec is kept (with its id, and in PostgreSQL its
 //! creation time): statistics are rebuilt by each replica from the spec.
 
 pub mod file;
 pub mod postgres;
+pub mod sessions;
 
 pub use file::{FORMAT, Store};
 pub use postgres::{DbError, PgStore};

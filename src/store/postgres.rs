@@ -70,7 +70,7 @@ pub enum DbError {
 /// Cloning gives another handle to the same pool.
 #[derive(Debug, Clone)]
 pub struct PgStore {
-    pool: PgPool,
+    pub(super) pool: PgPool,
     timeout: Duration,
     up: Arc<AtomicBool>,
 }
@@ -149,7 +149,7 @@ impl PgStore {
     /// Runs `call` within the timeout (a short one while the database is
     /// known to be down, so requests that need it fail fast) and records
     /// whether the database answered.
-    async fn bounded<T>(
+    pub(super) async fn bounded<T>(
         &self,
         call: impl Future<Output = Result<T, sqlx::Error>>,
     ) -> Result<T, DbError> {

@@ -206,3 +206,42 @@ async fn sessions_are_bounded_by_count_and_idle_time() {
         2.0
     );
 }
+
+#[tokio::test]
+async fn a_step_retried_with_its_idempotency_key_is_answered_not_made_again() {
+    let app = spawn_app().await;
+    let (id, _) = open(&app, &json!({"scenario_id": "paper-v10"})).await;
+    let path = format!("/v1/sessions/{id}/step");
+    let step = |key: &str, shift: f64| {
+        app.client
+            .post(app.url(&path))
+            .header("Idempotency-Key", key)
+            .json(&json!({"sensors": sensors(shift),
+                "detections": [{"x": 60.0 + shift, "y": 40.0, "vx": 10.0, "vy": 0.0}]}))
+            .send()
+    };
+    let first = step("k-0", 0.0).await.unwrap();
+    assert_eq!(first.status(), StatusCode::OK);
+    let first = first.bytes().await.unwrap();
+    // The retry (even with another body) gets the first answer, to the
+    // byte, and the session did not move.
+    let again = step("k-0", 5.0).await.unwrap().bytes().await.unwrap();
+    assert_eq!(again, first);
+    let info = json_body(app.get(&format!("/v1/sessions/{id}")).await, StatusCode::OK).await;
+    assert_eq!(info["step"], 1);
+    assert_eq!(info["tracks"].as_array().unwrap().len(), 1);
+    // A new key is a new step; without a key, every request is one.
+    let second: Value = step("k-1", 5.0).await.unwrap().json().await.unwrap();
+    assert_eq!(second["step"], 1);
+    let res = app
+        .post_json(&path, &json!({"sensors": sensors(0.0), "detections": []}))
+        .await;
+    assert_eq!(json_body(res, StatusCode::OK).await["step"], 2);
+    let res = app
+        .post_json(&path, &json!({"sensors": sensors(0.0), "detections": []}))
+        .await;
+    assert_eq!(json_body(res, StatusCode::OK).await["step"], 3);
+    // A key over 128 characters is refused.
+    let res = step(&"k".repeat(129), 0.0).await.unwrap();
+    assert_problem(res, StatusCode::BAD_REQUEST, "Idempotency-Key").await;
+}

@@ -11,6 +11,7 @@
 
 mod cluster;
 mod server;
+mod sessions;
 mod tests;
 
 use std::future::Future;

@@ -106,6 +106,17 @@ impl Server {
             .expect("POST answered")
     }
 
+    /// POST `body` to `path` with an `Idempotency-Key`.
+    pub async fn post_with_key(&self, path: &str, body: &Value, key: &str) -> Response {
+        self.client
+            .post(format!("{}{path}", self.address))
+            .header("Idempotency-Key", key)
+            .json(body)
+            .send()
+            .await
+            .expect("POST answered")
+    }
+
     /// A one-sensor plan on scenario `id`.
     pub async fn plan(&self, id: &str) -> Response {
         self.post(
@@ -120,6 +131,18 @@ impl Server {
         let text = self.get("/metrics").await.text().await.ok()?;
         text.lines()
             .find(|l| l.split(['{', ' ']).next() == Some(name))
+            .and_then(|l| l.rsplit(' ').next())
+            .and_then(|v| v.parse().ok())
+    }
+}
+
+impl Server {
+    /// The value of the Prometheus sample named `name` whose labels include
+    /// `label` (e.g. `reason="idle"`).
+    pub async fn metric_with(&self, name: &str, label: &str) -> Option<f64> {
+        let text = self.get("/metrics").await.text().await.ok()?;
+        text.lines()
+            .find(|l| l.split(['{', ' ']).next() == Some(name) && l.contains(label))
             .and_then(|l| l.rsplit(' ').next())
             .and_then(|v| v.parse().ok())
     }

@@ -11,6 +11,7 @@ use sqlx::Connection;
 use crate::Test;
 use crate::cluster::Cluster;
 use crate::server::{Server, assert_unavailable, body, spec};
+use crate::sessions;
 
 /// Every test, in the order run (the one that stops the server last).
 pub const ALL: &[(&str, Test)] = &[
@@ -33,6 +34,18 @@ pub const ALL: &[(&str, Test)] = &[
     ("import_dir", |c| Box::pin(import_dir(c))),
     ("newer_schema_refused", |c| {
         Box::pin(newer_schema_refused(c))
+    }),
+    ("sessions_across_replicas", |c| {
+        Box::pin(sessions::sessions_across_replicas(c))
+    }),
+    ("concurrent_steps_are_serialised", |c| {
+        Box::pin(sessions::concurrent_steps_are_serialised(c))
+    }),
+    ("retried_steps_are_made_once", |c| {
+        Box::pin(sessions::retried_steps_are_made_once(c))
+    }),
+    ("session_bounds_across_replicas", |c| {
+        Box::pin(sessions::session_bounds_across_replicas(c))
     }),
     ("database_outage", |c| Box::pin(database_outage(c))),
 ];
@@ -71,7 +84,7 @@ async fn replicas_start_at_once(cluster: Arc<Cluster>) {
         .fetch_one(&mut conn)
         .await
         .unwrap();
-    assert_eq!(n, 1);
+    assert_eq!(n as usize, vigil::store::postgres::MIGRATOR.iter().count());
 }
 
 /// Registered through A: read, planned and listed through B; deleted
@@ -423,8 +436,8 @@ async fn newer_schema_refused(cluster: Arc<Cluster>) {
 
 /// The database stops in the middle of a run and comes back on the same
 /// port: meanwhile, plans on cached, built-in and inline scenarios answer
-/// 200; catalogue writes and uncached reads answer 503 problem+json with
-/// Retry-After, fast; no other 5xx; `/healthz` and the gauge say so. After,
+/// 200; catalogue writes, uncached reads and sessions answer 503
+/// problem+json with Retry-After, fast; no other 5xx; `/healthz` and the gauge say so. After,
 /// everything works again without restarting either server.
 async fn database_outage(cluster: Arc<Cluster>) {
     assert!(
@@ -457,6 +470,15 @@ async fn database_outage(cluster: Arc<Cluster>) {
         assert_eq!(s.plan(&cached).await.status(), StatusCode::OK);
         assert_eq!(s.plan(&doomed).await.status(), StatusCode::OK);
     }
+    let (_, session) = body(
+        a.post("/v1/sessions", &json!({"scenario_id": "paper-v10"}))
+            .await,
+    )
+    .await;
+    let session = format!("/v1/sessions/{}", session["id"].as_str().unwrap());
+    let step = json!({"sensors": [{"id": "a", "x": 15, "y": 15}], "detections": []});
+    let (status, first) = body(a.post(&format!("{session}/step"), &step).await).await;
+    assert_eq!((status, &first["step"]), (StatusCode::OK, &json!(0)));
 
     cluster.stop();
     let stopped = Instant::now();
@@ -493,8 +515,10 @@ async fn database_outage(cluster: Arc<Cluster>) {
             assert_unavailable(s.get("/v1/scenarios").await, "list").await;
             assert_unavailable(s.get(&format!("/v1/scenarios/{uncached}")).await, "read").await;
             assert_unavailable(s.plan(uncached).await, "plan uncached").await;
+            assert_unavailable(s.post(&format!("{session}/step"), &step).await, "step").await;
+            assert_unavailable(s.get(&session).await, "session").await;
             let took = t.elapsed();
-            // Ten requests, none near the request timeout.
+            // Twelve requests, none near the request timeout.
             assert!(
                 took < Duration::from_millis(timeout_ms),
                 "round {round} took {took:?}"
@@ -527,7 +551,14 @@ async fn database_outage(cluster: Arc<Cluster>) {
             tokio::time::sleep(Duration::from_millis(50)).await;
         }
     }
-    // Everything works again, without a restart.
+    // Everything works again, without a restart: the session goes on
+    // from its last stored step.
+    let (status, second) = body(b.post(&format!("{session}/step"), &step).await).await;
+    assert_eq!(
+        (status, &second["step"]),
+        (StatusCode::OK, &json!(1)),
+        "{second}"
+    );
     let (status, created) = body(a.post("/v1/scenarios", &spec(60)).await).await;
     assert_eq!(status, StatusCode::CREATED, "{created}");
     assert_eq!(b.plan(&uncached_b).await.status(), StatusCode::OK);

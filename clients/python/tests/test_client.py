@@ -163,8 +163,11 @@ def test_a_session_steps_and_is_deleted_at_the_end(vigil: Vigil) -> None:
         assert first.step == 0 and first.horizon == 2
         assert_legal(first, 10.0, 2)
         moved = [{"id": p.sensor, "x": p.path[0].x, "y": p.path[0].y} for p in first.plans]
-        second = session.step({"sensors": moved})
+        second = session.step({"sensors": moved}, idempotency_key="second")
         assert second.step == 1
+        # Asked again under its key, the step is answered, not made again.
+        again = session.step({"sensors": moved}, idempotency_key="second")
+        assert again == second
         info = session.refresh()
         assert info.step == 2 and info.history_held == 2
         assert [t.id for t in info.tracks] == ["t"]

@@ -9,6 +9,7 @@ Transport failures (connection refused, timeouts) raise httpx's exceptions.
 
 from __future__ import annotations
 
+import uuid
 from collections.abc import Callable, Mapping
 from types import TracebackType
 from typing import Any
@@ -248,10 +249,19 @@ class Session:
         """The session's id."""
         return self.info.id
 
-    def step(self, request: StepRequest | Body) -> StepResponse:
-        """`POST /v1/sessions/{id}/step`: reports this step and plans from it."""
+    def step(self, request: StepRequest | Body, *, idempotency_key: str | None = None) -> StepResponse:
+        """`POST /v1/sessions/{id}/step`: reports this step and plans from it.
+
+        The step is sent with an `Idempotency-Key` (`idempotency_key`, else a new
+        random one), so a resend after a 503, including the client's own waits on
+        `Retry-After`, is answered rather than made twice. Pass the key of a step
+        whose answer was lost to ask for it again.
+        """
         body = _body(request, StepRequest)
-        return _result(step_session.sync_detailed(self.id, client=self._vigil.client, body=body))
+        key = idempotency_key if idempotency_key is not None else uuid.uuid4().hex
+        return _result(
+            step_session.sync_detailed(self.id, client=self._vigil.client, body=body, idempotency_key=key)
+        )
 
     def refresh(self) -> SessionInfo:
         """`GET /v1/sessions/{id}`: fetches the session's state into `info`."""
@@ -379,10 +389,13 @@ class AsyncSession:
         """The session's id."""
         return self.info.id
 
-    async def step(self, request: StepRequest | Body) -> StepResponse:
-        """`POST /v1/sessions/{id}/step`."""
+    async def step(self, request: StepRequest | Body, *, idempotency_key: str | None = None) -> StepResponse:
+        """`POST /v1/sessions/{id}/step`, with an `Idempotency-Key` as in `Session.step`."""
         body = _body(request, StepRequest)
-        return _result(await step_session.asyncio_detailed(self.id, client=self._vigil.client, body=body))
+        key = idempotency_key if idempotency_key is not None else uuid.uuid4().hex
+        return _result(
+            await step_session.asyncio_detailed(self.id, client=self._vigil.client, body=body, idempotency_key=key)
+        )
 
     async def refresh(self) -> SessionInfo:
         """`GET /v1/sessions/{id}`."""

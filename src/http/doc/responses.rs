@@ -77,6 +77,35 @@ pub struct ScenarioNotFound(pub Problem);
 )]
 pub struct SessionNotFound(pub Problem);
 
+/// Malformed step: its body is not acceptable JSON for the endpoint (see
+/// the other endpoints' 400), or its `Idempotency-Key` header is not 1 to
+/// 128 visible ASCII characters.
+#[derive(Debug, ToResponse)]
+#[response(
+    content_type = "application/problem+json",
+    examples(
+        ("syntax" = (summary = "Not JSON", value = json!(problem(ApiError::MalformedBody(
+            "Failed to parse the request body as JSON: EOF while parsing an object at line 1 column 1".to_owned()
+        ))))),
+        ("idempotency-key" = (summary = "An Idempotency-Key too long", value = json!(problem(
+            ApiError::BadHeader("Idempotency-Key: must have 1 to 128 characters, not 200".to_owned())
+        )))),
+    )
+)]
+pub struct MalformedStep(pub Problem);
+
+/// Other steps of the session were stored (through other replicas) while
+/// this one was made, each time it was made anew from their state: nothing
+/// of this step was stored. Send it again; with the same
+/// `Idempotency-Key`, a step that was stored after all is answered, not
+/// made twice.
+#[derive(Debug, ToResponse)]
+#[response(
+    content_type = "application/problem+json",
+    example = json!(problem(ApiError::SessionConflict("ss-0c5d2f6e8a9b4c3d9e7f1a2b3c4d5e6f".to_owned())))
+)]
+pub struct SessionConflict(pub Problem);
+
 /// A session's defaults are out of bounds, or the body gives both or
 /// neither of `scenario_id` and `scenario`, or its inline scenario is
 /// invalid or too large to precompute synchronously.

@@ -5,20 +5,24 @@ from urllib.parse import quote
 import httpx
 
 from ...client import AuthenticatedClient, Client
-from ...types import Response
+from ...types import Response, UNSET
 from ... import errors
 
 from ...models.problem import Problem
 from ...models.step_request import StepRequest
 from ...models.step_response import StepResponse
+from ...types import Unset
 
 
 def _get_kwargs(
     id: str,
     *,
     body: StepRequest,
+    idempotency_key: None | str | Unset = UNSET,
 ) -> dict[str, Any]:
     headers: dict[str, Any] = {}
+    if not isinstance(idempotency_key, Unset):
+        headers["Idempotency-Key"] = idempotency_key
 
     _kwargs: dict[str, Any] = {
         "method": "post",
@@ -57,6 +61,11 @@ def _parse_response(
         response_404 = Problem.from_dict(response.json())
 
         return response_404
+
+    if response.status_code == 409:
+        response_409 = Problem.from_dict(response.json())
+
+        return response_409
 
     if response.status_code == 413:
         response_413 = Problem.from_dict(response.json())
@@ -100,6 +109,7 @@ def sync_detailed(
     *,
     client: AuthenticatedClient,
     body: StepRequest,
+    idempotency_key: None | str | Unset = UNSET,
 ) -> Response[Problem | StepResponse]:
     """Plan the next step of a session
 
@@ -109,11 +119,15 @@ def sync_detailed(
     `history_steps` steps, and plans from the sensors now, the tracks and the sensors' positions over
     the last `history_steps` steps: the same plan as the stateless request of that state. Only a step
     whose plan is made is recorded, so a step that failed (4xx, 5xx) may be sent again. Steps of one
-    session run one at a time. Rules no schema can state (each a 422 whose `detail` names the field):
+    session run one at a time, each from the state the one before left, whichever replica serves them. A
+    step sent with an `Idempotency-Key` header is answered, to the byte, with the first answer to that
+    key if the session's last step had it, and is not made again: send one to retry safely after a lost
+    answer, a timeout or a 503. Rules no schema can state (each a 422 whose `detail` names the field):
     every sensor and history position lies in the scenario's zone, and sensor ids are unique.
 
     Args:
         id (str):
+        idempotency_key (None | str | Unset):
         body (StepRequest): Body of a session's step.
 
     Raises:
@@ -127,6 +141,7 @@ def sync_detailed(
     kwargs = _get_kwargs(
         id=id,
         body=body,
+        idempotency_key=idempotency_key,
     )
 
     response = client.get_httpx_client().request(
@@ -141,6 +156,7 @@ def sync(
     *,
     client: AuthenticatedClient,
     body: StepRequest,
+    idempotency_key: None | str | Unset = UNSET,
 ) -> Problem | StepResponse | None:
     """Plan the next step of a session
 
@@ -150,11 +166,15 @@ def sync(
     `history_steps` steps, and plans from the sensors now, the tracks and the sensors' positions over
     the last `history_steps` steps: the same plan as the stateless request of that state. Only a step
     whose plan is made is recorded, so a step that failed (4xx, 5xx) may be sent again. Steps of one
-    session run one at a time. Rules no schema can state (each a 422 whose `detail` names the field):
+    session run one at a time, each from the state the one before left, whichever replica serves them. A
+    step sent with an `Idempotency-Key` header is answered, to the byte, with the first answer to that
+    key if the session's last step had it, and is not made again: send one to retry safely after a lost
+    answer, a timeout or a 503. Rules no schema can state (each a 422 whose `detail` names the field):
     every sensor and history position lies in the scenario's zone, and sensor ids are unique.
 
     Args:
         id (str):
+        idempotency_key (None | str | Unset):
         body (StepRequest): Body of a session's step.
 
     Raises:
@@ -169,6 +189,7 @@ def sync(
         id=id,
         client=client,
         body=body,
+        idempotency_key=idempotency_key,
     ).parsed
 
 
@@ -177,6 +198,7 @@ async def asyncio_detailed(
     *,
     client: AuthenticatedClient,
     body: StepRequest,
+    idempotency_key: None | str | Unset = UNSET,
 ) -> Response[Problem | StepResponse]:
     """Plan the next step of a session
 
@@ -186,11 +208,15 @@ async def asyncio_detailed(
     `history_steps` steps, and plans from the sensors now, the tracks and the sensors' positions over
     the last `history_steps` steps: the same plan as the stateless request of that state. Only a step
     whose plan is made is recorded, so a step that failed (4xx, 5xx) may be sent again. Steps of one
-    session run one at a time. Rules no schema can state (each a 422 whose `detail` names the field):
+    session run one at a time, each from the state the one before left, whichever replica serves them. A
+    step sent with an `Idempotency-Key` header is answered, to the byte, with the first answer to that
+    key if the session's last step had it, and is not made again: send one to retry safely after a lost
+    answer, a timeout or a 503. Rules no schema can state (each a 422 whose `detail` names the field):
     every sensor and history position lies in the scenario's zone, and sensor ids are unique.
 
     Args:
         id (str):
+        idempotency_key (None | str | Unset):
         body (StepRequest): Body of a session's step.
 
     Raises:
@@ -204,6 +230,7 @@ async def asyncio_detailed(
     kwargs = _get_kwargs(
         id=id,
         body=body,
+        idempotency_key=idempotency_key,
     )
 
     response = await client.get_async_httpx_client().request(**kwargs)
@@ -216,6 +243,7 @@ async def asyncio(
     *,
     client: AuthenticatedClient,
     body: StepRequest,
+    idempotency_key: None | str | Unset = UNSET,
 ) -> Problem | StepResponse | None:
     """Plan the next step of a session
 
@@ -225,11 +253,15 @@ async def asyncio(
     `history_steps` steps, and plans from the sensors now, the tracks and the sensors' positions over
     the last `history_steps` steps: the same plan as the stateless request of that state. Only a step
     whose plan is made is recorded, so a step that failed (4xx, 5xx) may be sent again. Steps of one
-    session run one at a time. Rules no schema can state (each a 422 whose `detail` names the field):
+    session run one at a time, each from the state the one before left, whichever replica serves them. A
+    step sent with an `Idempotency-Key` header is answered, to the byte, with the first answer to that
+    key if the session's last step had it, and is not made again: send one to retry safely after a lost
+    answer, a timeout or a 503. Rules no schema can state (each a 422 whose `detail` names the field):
     every sensor and history position lies in the scenario's zone, and sensor ids are unique.
 
     Args:
         id (str):
+        idempotency_key (None | str | Unset):
         body (StepRequest): Body of a session's step.
 
     Raises:
@@ -245,5 +277,6 @@ async def asyncio(
             id=id,
             client=client,
             body=body,
+            idempotency_key=idempotency_key,
         )
     ).parsed

@@ -1,0 +1,215 @@
+//! Sessions kept in the database: any replica serves any session, a
+//! `kill -9` loses no acknowledged step, concurrent steps are serialised,
+//! a retried step is not made twice, and the idle time and count hold
+//! across replicas.
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use reqwest::StatusCode;
+use serde_json::{Value, json};
+
+use crate::cluster::Cluster;
+use crate::server::{Server, body, spec};
+
+/// Step `k` of a deterministic run: two sensors moving, and a target
+/// detected every third step.
+fn step_body(k: u32) -> Value {
+    let x = 15.0 + f64::from(k % 7) * 10.0;
+    let detections = if k.is_multiple_of(3) {
+        json!([{"id": k, "x": 5.0 + f64::from(k), "y": 50.0, "vx": 6.0, "vy": 0.0}])
+    } else {
+        json!([])
+    };
+    json!({
+        "sensors": [{"id": "a", "x": x, "y": 25.0}, {"id": "b", "x": 85.0, "y": x}],
+        "detections": detections,
+    })
+}
+
+/// A step's answer without its timing.
+fn answer(mut v: Value) -> Value {
+    if let Some(o) = v.as_object_mut() {
+        o.remove("compute_micros");
+    }
+    v
+}
+
+async fn open(server: &Server, body_json: &Value) -> String {
+    let (status, info) = body(server.post("/v1/sessions", body_json).await).await;
+    assert_eq!(status, StatusCode::CREATED, "{info}");
+    info["id"].as_str().unwrap().to_owned()
+}
+
+async fn step(server: &Server, id: &str, k: u32) -> Value {
+    let (status, v) = body(
+        server
+            .post(&format!("/v1/sessions/{id}/step"), &step_body(k))
+            .await,
+    )
+    .await;
+    assert_eq!(status, StatusCode::OK, "step {k}: {v}");
+    answer(v)
+}
+
+/// A session on an inline scenario, stepped alternately through two
+/// replicas, one of which is killed with SIGKILL mid-run and restarted:
+/// every step answers as the same session on a single replica does, and
+/// both replicas read the same session.
+pub async fn sessions_across_replicas(cluster: Arc<Cluster>) {
+    let url = cluster.database("sessions_across").await;
+    let one = Server::start("one", &url, &[]);
+    let mut a = Server::start("a", &url, &[]);
+    let b = Server::start("b", &url, &[]);
+    let create = json!({"scenario": spec(7), "history_steps": 4});
+    let reference = open(&one, &create).await;
+    let shared = open(&a, &create).await;
+    for k in 0..14 {
+        let expected = step(&one, &reference, k).await;
+        if k == 6 {
+            // Killed after acknowledging steps 0..=5: the next steps go
+            // to B, then to A restarted.
+            a.kill();
+        }
+        if k == 9 {
+            a = Server::start("a2", &url, &[]);
+        }
+        let server = if (6..9).contains(&k) || k % 2 == 1 {
+            &b
+        } else {
+            &a
+        };
+        assert_eq!(step(server, &shared, k).await, expected, "step {k}");
+    }
+    for server in [&a, &b] {
+        let (status, info) = body(server.get(&format!("/v1/sessions/{shared}")).await).await;
+        assert_eq!(status, StatusCode::OK);
+        assert_eq!(info["step"], 14);
+        let (_, reference_info) = body(one.get(&format!("/v1/sessions/{reference}")).await).await;
+        assert_eq!(info["tracks"], reference_info["tracks"]);
+    }
+}
+
+/// Steps sent at once through two replicas: each answered one is made
+/// from the one before (distinct, consecutive step numbers), the others
+/// are refused with 409, and the session counts exactly the answered.
+pub async fn concurrent_steps_are_serialised(cluster: Arc<Cluster>) {
+    let url = cluster.database("sessions_concurrent").await;
+    let a = Arc::new(Server::start("a", &url, &[]));
+    let b = Arc::new(Server::start("b", &url, &[]));
+    let id = open(&a, &json!({"scenario_id": "paper-v10"})).await;
+    let tasks: Vec<_> = (0..12u32)
+        .map(|k| {
+            let server = if k % 2 == 0 { a.clone() } else { b.clone() };
+            let id = id.clone();
+            tokio::spawn(async move {
+                let res = server
+                    .post(&format!("/v1/sessions/{id}/step"), &step_body(k))
+                    .await;
+                body(res).await
+            })
+        })
+        .collect();
+    let mut steps = Vec::new();
+    for task in tasks {
+        let (status, v) = task.await.unwrap();
+        match status {
+            StatusCode::OK => steps.push(v["step"].as_u64().unwrap()),
+            StatusCode::CONFLICT => assert_eq!(
+                v["type"], "https://vigil.dev/problems/session-step-conflict",
+                "{v}"
+            ),
+            other => panic!("{other}: {v}"),
+        }
+    }
+    steps.sort_unstable();
+    let n = steps.len() as u64;
+    assert!(n >= 2, "{steps:?}");
+    assert_eq!(steps, (0..n).collect::<Vec<_>>());
+    for server in [&a, &b] {
+        let (_, info) = body(server.get(&format!("/v1/sessions/{id}")).await).await;
+        assert_eq!(info["step"], n);
+    }
+}
+
+/// A step retried with its Idempotency-Key, on the other replica and at
+/// once on both, is answered with the first answer and made once.
+pub async fn retried_steps_are_made_once(cluster: Arc<Cluster>) {
+    let url = cluster.database("sessions_retry").await;
+    let a = Arc::new(Server::start("a", &url, &[]));
+    let b = Arc::new(Server::start("b", &url, &[]));
+    let id = open(&a, &json!({"scenario_id": "paper-v10"})).await;
+    let send = |server: Arc<Server>, key: &'static str, k: u32| {
+        let id = id.clone();
+        async move {
+            let res = server
+                .post_with_key(&format!("/v1/sessions/{id}/step"), &step_body(k), key)
+                .await;
+            assert_eq!(res.status(), StatusCode::OK);
+            res.bytes().await.unwrap()
+        }
+    };
+    let first = send(a.clone(), "step-0", 0).await;
+    assert_eq!(send(b.clone(), "step-0", 0).await, first);
+    assert_eq!(send(a.clone(), "step-0", 0).await, first);
+    // The same new step through both at once: made once.
+    let (x, y) = tokio::join!(
+        tokio::spawn(send(a.clone(), "step-1", 1)),
+        tokio::spawn(send(b.clone(), "step-1", 1))
+    );
+    let (x, y) = (x.unwrap(), y.unwrap());
+    assert_eq!(x, y);
+    let x: Value = serde_json::from_slice(&x).unwrap();
+    assert_eq!(x["step"], 1);
+    let (_, info) = body(b.get(&format!("/v1/sessions/{id}")).await).await;
+    assert_eq!(info["step"], 2);
+}
+
+/// The idle time to live and the count hold across replicas: a session
+/// created through one replica is evicted by a creation through the
+/// other, and one idle past the time to live is gone from both.
+pub async fn session_bounds_across_replicas(cluster: Arc<Cluster>) {
+    let url = cluster.database("sessions_bounds").await;
+    let args = ["--session-ttl-s", "2", "--max-sessions", "2"];
+    let a = Server::start("a", &url, &args);
+    let b = Server::start("b", &url, &args);
+    let create = json!({"scenario_id": "paper-v10"});
+    let first = open(&a, &create).await;
+    let second = open(&b, &create).await;
+    // Using the first makes the second the least recently used.
+    assert_eq!(
+        b.get(&format!("/v1/sessions/{first}")).await.status(),
+        StatusCode::OK
+    );
+    let third = open(&a, &create).await;
+    for server in [&a, &b] {
+        let path = format!("/v1/sessions/{second}");
+        assert_eq!(server.get(&path).await.status(), StatusCode::NOT_FOUND);
+        let path = format!("/v1/sessions/{first}");
+        assert_eq!(server.get(&path).await.status(), StatusCode::OK);
+    }
+    assert_eq!(
+        a.metric_with("vigil_sessions_evicted_total", "reason=\"capacity\"")
+            .await,
+        Some(1.0)
+    );
+    // Both idle past the time to live: gone everywhere.
+    let idle = Instant::now();
+    tokio::time::sleep(Duration::from_millis(2500)).await;
+    for id in [&first, &third] {
+        for server in [&a, &b] {
+            let (status, problem) = body(server.get(&format!("/v1/sessions/{id}")).await).await;
+            assert_eq!(status, StatusCode::NOT_FOUND, "{problem}");
+        }
+    }
+    assert!(idle.elapsed() >= Duration::from_secs(2));
+    let idle_a = a
+        .metric_with("vigil_sessions_evicted_total", "reason=\"idle\"")
+        .await
+        .unwrap_or(0.0);
+    let idle_b = b
+        .metric_with("vigil_sessions_evicted_total", "reason=\"idle\"")
+        .await
+        .unwrap_or(0.0);
+    assert_eq!(idle_a + idle_b, 2.0);
+}
