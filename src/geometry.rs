@@ -9,7 +9,7 @@
 use std::sync::LazyLock;
 
 /// A point or vector in zone units.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Point {
     /// East coordinate.
     pub x: f64,
@@ -25,7 +25,7 @@ impl Point {
 }
 
 /// An axis-aligned closed rectangle `[x0,x1] × [y0,y1]`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Rect {
     /// West edge.
     pub x0: f64,
@@ -99,7 +99,7 @@ impl Rect {
 }
 
 /// A closed disk.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Disk {
     /// Centre.
     pub c: Point,
@@ -110,7 +110,7 @@ pub struct Disk {
 /// A field of view clipped to the zone: `rect ∩ disk`, where the rectangle is
 /// the square FOV (or the circle's bounding square) already clipped to the
 /// zone. Always convex.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Region {
     /// The clipped square.
     pub rect: Rect,

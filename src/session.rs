@@ -55,7 +55,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use crate::coordination::{Coordination, Objective};
-use crate::fit::{FitTolerance, LearntStep, RateLearner, Tolerances};
+use crate::fit::{FitTolerance, LearnerSnapshot, LearntStep, RateLearner, Tolerances};
 use crate::geometry::Point;
 use crate::limits::{DEFAULT_HISTORY_STEPS, MAX_HISTORY_STEPS, MAX_TARGETS};
 use crate::planner::{
@@ -293,6 +293,9 @@ pub struct Snapshot {
     step: u64,
     history: VecDeque<Vec<PositionIn>>,
     tracks: Vec<Track>,
+    /// With `learn_rates`: what it learnt.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    learner: Option<LearnerSnapshot>,
 }
 
 impl Snapshot {
@@ -355,20 +358,40 @@ impl Session {
             step: self.step,
             history: self.history.clone(),
             tracks: self.tracks.clone(),
+            learner: self.learner.as_ref().map(|l| l.snapshot()),
         }
     }
 
-    /// The session of `snapshot` on `planner`, its scenario's. A snapshot
-    /// holds no learnt rates: a store of snapshots refuses sessions that
-    /// learn them.
-    pub fn restore(planner: Arc<Planner>, snapshot: Snapshot) -> Self {
+    /// The session of `snapshot` on `planner`, its scenario's. A learning
+    /// session plans with `reuse` (the planner of the session it was
+    /// before, say) if that is at the rates it planned at, else with a
+    /// planner built at them: CPU work, up to a precomputation.
+    ///
+    /// # Errors
+    /// A message when the snapshot does not fit `planner`'s scenario.
+    pub fn restore(
+        planner: Arc<Planner>,
+        snapshot: Snapshot,
+        reuse: Option<Arc<Planner>>,
+    ) -> Result<Self, String> {
         let mut session = Session::new(planner, snapshot.settings);
         session.history_len = snapshot.history_len.min(MAX_HISTORY_STEPS);
         session.step = snapshot.step;
         session.history = snapshot.history;
         session.history.truncate(session.history_len);
         session.tracks = snapshot.tracks;
-        session
+        session.learner = match (session.learner.take(), snapshot.learner) {
+            (None, None) => None,
+            (Some(fresh), Some(learnt)) => Some(Arc::new(RateLearner::restore(
+                fresh.base().clone(),
+                fresh.tolerances(),
+                fresh.whole_zone(),
+                learnt,
+                reuse,
+            )?)),
+            _ => return Err("a snapshot's learnt state does not match its settings".into()),
+        };
+        Ok(session)
     }
 
     /// With `learn_rates`: its learnt rates.
@@ -645,7 +668,7 @@ mod tests {
         let bytes = s.snapshot().encode();
         let back = Snapshot::decode(&bytes).unwrap();
         assert_eq!(back, s.snapshot());
-        let restored = Session::restore(s.planner().clone(), back);
+        let restored = Session::restore(s.planner().clone(), back, None).unwrap();
         let next = step(vec![anonymous(10.0, 20.0, 1.0)]);
         assert_eq!(restored.prepare(&next).request, s.prepare(&next).request);
         assert_eq!(restored.step(), 5);

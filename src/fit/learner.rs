@@ -12,6 +12,8 @@
 use std::collections::VecDeque;
 use std::sync::Arc;
 
+use serde::{Deserialize, Serialize};
+
 use super::exposure::WindowLooks;
 use super::posterior::Prior;
 use super::window::{Observed, Tolerances, TrackBook};
@@ -66,6 +68,20 @@ impl LearntStep {
     }
 }
 
+/// What a learner holds apart from its scenario, tolerances and planners:
+/// what a session's snapshot carries ([`RateLearner::snapshot`],
+/// [`RateLearner::restore`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LearnerSnapshot {
+    recent: VecDeque<Vec<Look>>,
+    book: TrackBook,
+    exposure: Vec<f64>,
+    attribution: Attribution,
+    step: u64,
+    /// The source rates of the planner plans are made with.
+    planned_rates: Vec<f64>,
+}
+
 impl RateLearner {
     /// A learner with nothing observed: the scenario prior, and `base`'s
     /// planner.
@@ -88,6 +104,75 @@ impl RateLearner {
             whole_zone,
             base,
         }
+    }
+
+    /// Its state, less its scenario, tolerances and planners.
+    pub fn snapshot(&self) -> LearnerSnapshot {
+        LearnerSnapshot {
+            recent: self.recent.clone(),
+            book: self.book.clone(),
+            exposure: self.exposure.clone(),
+            attribution: self.attribution.clone(),
+            step: self.step,
+            planned_rates: rates_of(&self.planner),
+        }
+    }
+
+    /// The learner of `snapshot` on `base` (as [`RateLearner::new`]),
+    /// planning with `base`, with `reuse` if it plans at the snapshot's
+    /// rates, or else with a planner built at them (a precomputation).
+    ///
+    /// # Errors
+    /// A message when the snapshot does not fit `base`'s scenario.
+    pub fn restore(
+        base: Arc<Planner>,
+        tolerances: Tolerances,
+        whole_zone: bool,
+        snapshot: LearnerSnapshot,
+        reuse: Option<Arc<Planner>>,
+    ) -> Result<Self, String> {
+        let mut learner = RateLearner::new(base, tolerances, whole_zone);
+        let sources = learner.base.scenario.sources.len();
+        if [
+            snapshot.exposure.len(),
+            snapshot.attribution.own.len(),
+            snapshot.planned_rates.len(),
+        ] != [sources; 3]
+        {
+            return Err(format!(
+                "a learner's snapshot does not have the scenario's {sources} sources"
+            ));
+        }
+        learner.planner = if snapshot.planned_rates == rates_of(&learner.base) {
+            learner.base.clone()
+        } else if let Some(reuse) = reuse.filter(|p| rates_of(p) == snapshot.planned_rates) {
+            reuse
+        } else {
+            learner
+                .planner_at(&snapshot.planned_rates)
+                .ok_or("a learner's snapshot has rates its scenario refuses")?
+        };
+        learner.recent = snapshot.recent;
+        learner.book = snapshot.book;
+        learner.exposure = snapshot.exposure;
+        learner.attribution = snapshot.attribution;
+        learner.step = snapshot.step;
+        Ok(learner)
+    }
+
+    /// The scenario as registered.
+    pub fn base(&self) -> &Arc<Planner> {
+        &self.base
+    }
+
+    /// Its tolerances.
+    pub fn tolerances(&self) -> Tolerances {
+        self.tolerances
+    }
+
+    /// Whether each step's look is the whole zone.
+    pub fn whole_zone(&self) -> bool {
+        self.whole_zone
     }
 
     /// Steps of looks kept: the longest a target can stay in the zone.
@@ -197,9 +282,15 @@ impl RateLearner {
         if !drifted {
             return None;
         }
+        let rates: Vec<f64> = rates.iter().map(|r| r.rate).collect();
+        self.planner_at(&rates)
+    }
+
+    /// A planner of the scenario at source rates `rates`, if valid.
+    fn planner_at(&self, rates: &[f64]) -> Option<Arc<Planner>> {
         let mut spec = self.base.scenario.spec.clone();
-        for (src, r) in spec.sources.iter_mut().zip(rates) {
-            src.rate = r.rate;
+        for (src, &rate) in spec.sources.iter_mut().zip(rates) {
+            src.rate = rate;
         }
         let scenario = Scenario::new(spec).ok()?;
         Some(Arc::new(Planner::new(scenario)))
@@ -220,4 +311,16 @@ impl RateLearner {
         }
         self.step += 1;
     }
+}
+
+/// The source rates `planner`'s spec gives (as [`RateLearner::planner_at`]
+/// sets them).
+fn rates_of(planner: &Planner) -> Vec<f64> {
+    planner
+        .scenario
+        .spec
+        .sources
+        .iter()
+        .map(|s| s.rate)
+        .collect()
 }

@@ -15,7 +15,7 @@ pub mod window;
 pub mod wire;
 
 pub use exposure::WindowLooks;
-pub use learner::{LearntStep, RateLearner};
+pub use learner::{LearnerSnapshot, LearntStep, RateLearner};
 pub use posterior::{Posterior, Prior};
 pub use traceback::Tolerance;
 pub use window::{FirstDetection, FitWindow, Observed, Tolerances, TrackBook};
@@ -25,7 +25,7 @@ use crate::scenario::Scenario;
 
 /// How each first detection is explained: by one source, by several (with
 /// their densities), or by none.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Attribution {
     /// Per source: detections that only it explains.
     pub own: Vec<f64>,

@@ -65,7 +65,7 @@ impl Tolerances {
 /// target counts once, and an id whose detections jump further than a
 /// target can fly is refused. Remembers at most `capacity` ids, forgetting
 /// the oldest.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TrackBook {
     last: HashMap<String, (u64, Point)>,
     order: VecDeque<String>,

@@ -109,11 +109,6 @@ impl SessionStore {
         self.ttl
     }
 
-    /// Whether sessions are kept in the database.
-    pub fn in_database(&self) -> bool {
-        self.db.is_some()
-    }
-
     fn lock(&self) -> std::sync::MutexGuard<'_, Map> {
         // Every critical section is a few map operations that cannot fail
         // half-way: poisoning cannot leave it inconsistent.
@@ -307,19 +302,6 @@ impl SessionStore {
             return Ok(Refreshed::Replay(Bytes::from(answer)));
         }
         if let Some(state) = row.state {
-            let snapshot = if row.format == Snapshot::FORMAT {
-                Snapshot::decode(&state)
-            } else {
-                Err(format!(
-                    "format {} (this server reads {})",
-                    row.format,
-                    Snapshot::FORMAT
-                ))
-            }
-            .map_err(|reason| {
-                tracing::error!(%id, %reason, "a stored session cannot be read");
-                ApiError::Internal(format!("stored session {id} cannot be read: {reason}"))
-            })?;
             let planner = match (&held.session, row.spec) {
                 (Some(session), _) => session.planner().clone(),
                 (None, Some(spec)) => resolve(row.scenario_id, spec).await?,
@@ -329,7 +311,28 @@ impl SessionStore {
                     )));
                 }
             };
-            let session = Session::restore(planner, snapshot);
+            let reuse = held
+                .session
+                .as_ref()
+                .and_then(|s| s.learner())
+                .map(|l| l.planner().clone());
+            let format = row.format;
+            // Decoding, and for a learning session maybe a precomputation:
+            // off the async workers.
+            let session = tokio::task::spawn_blocking(move || {
+                if format != Snapshot::FORMAT {
+                    return Err(format!(
+                        "format {format} (this server reads {})",
+                        Snapshot::FORMAT
+                    ));
+                }
+                Session::restore(planner, Snapshot::decode(&state)?, reuse)
+            })
+            .await?
+            .map_err(|reason| {
+                tracing::error!(%id, %reason, "a stored session cannot be read");
+                ApiError::Internal(format!("stored session {id} cannot be read: {reason}"))
+            })?;
             self.resize(id, session.memory_bytes());
             held.session = Some(session);
         }

@@ -164,13 +164,6 @@ pub async fn create(
             .into());
         }
     }
-    if settings.learn_rates == Some(true) && state.sessions.in_database() {
-        return Err(ValidationError::new(
-            "learn_rates",
-            "this server keeps sessions in its database (--database-url), which does not keep a session's learnt rates yet; learn rates with POST /v1/scenarios/{id}/fit, or on a server without a database",
-        )
-        .into());
-    }
     let session = Session::new(planner, settings);
     let info = SessionInfo::of(String::new(), &session);
     let (id, _) = state.sessions.create(session).await?;

@@ -103,7 +103,7 @@ pub struct NoGoSpec {
 
 /// One look: a field of view at a step and the probability that it detects
 /// a target inside it.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Look {
     /// The field of view, clipped to the zone.
     pub region: Region,

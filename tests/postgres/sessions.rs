@@ -90,6 +90,51 @@ pub async fn sessions_across_replicas(cluster: Arc<Cluster>) {
     }
 }
 
+/// Step `k` of a learning run: every detection in a look, with an id.
+fn learning_step(k: u32) -> Value {
+    let detections = if k.is_multiple_of(2) {
+        json!([{"id": format!("t{k}"), "x": 40.0 + f64::from(k % 5), "y": 50.0, "vx": 6.0, "vy": 0.0}])
+    } else {
+        json!([])
+    };
+    json!({
+        "sensors": [{"id": "a", "x": 50.0, "y": 50.0}, {"id": "b", "x": 20.0 + f64::from(k % 4) * 10.0, "y": 80.0}],
+        "detections": detections,
+    })
+}
+
+/// A session that learns rates, alternated between two replicas: every
+/// step's plan and learnt rates are those of the same session on one
+/// replica.
+pub async fn learning_sessions_across_replicas(cluster: Arc<Cluster>) {
+    let url = cluster.database("sessions_learning").await;
+    let one = Server::start("one", &url, &[]);
+    let a = Server::start("a", &url, &[]);
+    let b = Server::start("b", &url, &[]);
+    let create = json!({"scenario": spec(8), "learn_rates": true});
+    let reference = open(&one, &create).await;
+    let shared = open(&a, &create).await;
+    let mut scenarios = std::collections::HashSet::new();
+    for k in 0..12 {
+        let send = async |server: &Server, id: &str| {
+            let res = server
+                .post(&format!("/v1/sessions/{id}/step"), &learning_step(k))
+                .await;
+            let (status, v) = body(res).await;
+            assert_eq!(status, StatusCode::OK, "step {k}: {v}");
+            answer(v)
+        };
+        let expected = send(&one, &reference).await;
+        let server = if k % 2 == 0 { &b } else { &a };
+        let got = send(server, &shared).await;
+        assert_eq!(got, expected, "step {k}");
+        scenarios.insert(expected["scenario"].as_str().unwrap().to_owned());
+    }
+    // The rates drifted enough to plan on scenarios at learnt rates: the
+    // replicas rebuilt or kept those planners as the one replica did.
+    assert!(scenarios.len() >= 3, "{scenarios:?}");
+}
+
 /// Steps sent at once through two replicas: each answered one is made
 /// from the one before (distinct, consecutive step numbers), the others
 /// are refused with 409, and the session counts exactly the answered.

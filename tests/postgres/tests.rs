@@ -38,6 +38,9 @@ pub const ALL: &[(&str, Test)] = &[
     ("sessions_across_replicas", |c| {
         Box::pin(sessions::sessions_across_replicas(c))
     }),
+    ("learning_sessions_across_replicas", |c| {
+        Box::pin(sessions::learning_sessions_across_replicas(c))
+    }),
     ("concurrent_steps_are_serialised", |c| {
         Box::pin(sessions::concurrent_steps_are_serialised(c))
     }),
