@@ -24,6 +24,7 @@
 
 pub mod cancel;
 pub mod catalog;
+pub mod codec;
 pub mod coordination;
 pub mod cost;
 pub mod estimator;

@@ -34,6 +34,7 @@
 use rayon::prelude::*;
 
 use crate::cancel::{CancelToken, Cancelled, Progress};
+use crate::codec::{CodecError, Reader, Writer, expect_len};
 use crate::geometry::{Point, Region, gauss_legendre, inv_r_integral, wedge_inv_r_integral};
 use crate::limits::{MAX_HORIZON, OBSTACLE_STATS_RAYS_PER_PI};
 use crate::obstacle::Sight;
@@ -231,6 +232,31 @@ fn sighted_cell_rates(
 }
 
 impl Stats {
+    /// Writes these statistics ([`crate::codec`]).
+    pub fn encode(&self, w: &mut Writer) {
+        w.f64s(&self.lambda_hat);
+        w.f64s(&self.escape_time);
+        w.f64s(&self.d_hat);
+        w.f64(self.expected_targets_in_zone);
+    }
+
+    /// Reads statistics [`Stats::encode`] wrote, of `cells` cells.
+    ///
+    /// # Errors
+    /// A [`CodecError`] for bytes that are not such statistics.
+    pub fn decode(r: &mut Reader, cells: usize) -> Result<Self, CodecError> {
+        let stats = Stats {
+            lambda_hat: r.f64s()?,
+            escape_time: r.f64s()?,
+            d_hat: r.f64s()?,
+            expected_targets_in_zone: r.f64()?,
+        };
+        expect_len("lambda_hat", stats.lambda_hat.len(), cells)?;
+        expect_len("escape_time", stats.escape_time.len(), cells)?;
+        expect_len("d_hat", stats.d_hat.len(), cells)?;
+        Ok(stats)
+    }
+
     /// Computes the statistics of every cell for the type `default`'s view
     /// (in parallel).
     pub fn compute(s: &Scenario) -> Stats {

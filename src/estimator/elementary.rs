@@ -13,6 +13,7 @@
 
 use rayon::prelude::*;
 
+use crate::codec::{CodecError, Reader, Writer, expect_len};
 use crate::geometry::{Point, Rect, wedge_inv_r_integral};
 use crate::scenario::{Cell, FovSpec, Heading, Scenario, Source};
 
@@ -202,6 +203,75 @@ fn stationary_prefix(s: &Scenario, xs: &[f64], ys: &[f64]) -> Vec<f64> {
 }
 
 impl ElementaryGrid {
+    /// Writes this grid ([`crate::codec`]).
+    pub fn encode(&self, w: &mut Writer) {
+        w.f64s(&self.xs);
+        w.f64s(&self.ys);
+        for spans in [&self.col_span, &self.row_span] {
+            w.len(spans.len());
+            for per_fov in spans {
+                let flat: Vec<usize> = per_fov.iter().flat_map(|&(a, b)| [a, b]).collect();
+                w.usizes(&flat);
+            }
+        }
+        w.f64s(&self.prefix);
+        w.u32s(&self.x_buckets);
+        w.f64(self.x_scale);
+        w.u32s(&self.y_buckets);
+        w.f64(self.y_scale);
+    }
+
+    /// Reads a grid [`ElementaryGrid::encode`] wrote for scenario `s`.
+    ///
+    /// # Errors
+    /// A [`CodecError`] for bytes that are not such a grid.
+    pub fn decode(r: &mut Reader, s: &Scenario) -> Result<Self, CodecError> {
+        let xs = r.f64s()?;
+        let ys = r.f64s()?;
+        let mut spans = [Vec::new(), Vec::new()];
+        for ((axis, lines), breaks) in spans
+            .iter_mut()
+            .zip([s.cols as usize, s.rows as usize])
+            .zip([xs.len(), ys.len()])
+        {
+            let n = r.len()?;
+            expect_len("grid spans", n, s.fovs.len())?;
+            for _ in 0..n {
+                let flat = r.usizes()?;
+                expect_len("grid span", flat.len(), 2 * lines)?;
+                if flat.iter().any(|&i| i >= breaks) {
+                    return Err(CodecError("a grid span out of range".into()));
+                }
+                axis.push(flat.chunks_exact(2).map(|p| (p[0], p[1])).collect());
+            }
+        }
+        let [col_span, row_span] = spans;
+        let grid = ElementaryGrid {
+            prefix: r.f64s()?,
+            x_buckets: r.u32s()?,
+            x_scale: r.f64()?,
+            y_buckets: r.u32s()?,
+            y_scale: r.f64()?,
+            xs,
+            ys,
+            col_span,
+            row_span,
+        };
+        if grid.xs.len() < 2 || grid.ys.len() < 2 {
+            return Err(CodecError("a grid without intervals".into()));
+        }
+        expect_len(
+            "grid prefix",
+            grid.prefix.len(),
+            grid.xs.len() * grid.ys.len(),
+        )?;
+        let in_range = |b: &[u32], n: usize| b.iter().all(|&i| (i as usize) + 1 < n);
+        if !in_range(&grid.x_buckets, grid.xs.len()) || !in_range(&grid.y_buckets, grid.ys.len()) {
+            return Err(CodecError("grid buckets out of range".into()));
+        }
+        Ok(grid)
+    }
+
     /// The grid of a scenario whose sensor types all have square fields of
     /// view (the breakpoints of every size), with the closed-form
     /// stationary mass; `None` when one is a circle, or when several sizes

@@ -12,5 +12,5 @@ pub mod wire;
 pub use input::PlanInput;
 pub(crate) use input::{check_certify, check_estimator, check_objective, place};
 pub(crate) use planning::Chosen;
-pub use planning::Planner;
+pub use planning::{PRECOMPUTED_FORMAT, Planner};
 pub use wire::*;

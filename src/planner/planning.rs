@@ -8,6 +8,7 @@ use std::time::Instant;
 use super::input::PlanInput;
 use super::wire::*;
 use crate::cancel::{CancelToken, Cancelled, Progress};
+use crate::codec::{CodecError, Reader, Writer, expect_len};
 use crate::coordination::{Fleet, Objective, coordinate};
 use crate::estimator::{
     ElementaryGrid, Estimator, ExactEstimator, FirstDetections, PaperEstimator, Precomputed,
@@ -15,6 +16,14 @@ use crate::estimator::{
 };
 use crate::scenario::{Cell, Look, Scenario, ValidationError};
 use crate::stats::Stats;
+
+/// The version of [`Planner::encode_precomputed`]'s bytes: raise it with
+/// any change to what they hold or how, so that a replica never reads
+/// another build's bytes as its own.
+pub const PRECOMPUTED_FORMAT: u32 = 1;
+
+/// The first bytes of [`Planner::encode_precomputed`]'s.
+const PRECOMPUTED_MAGIC: &[u8] = b"vigil-precomputed";
 
 /// A scenario with its precomputed statistics, ready to plan.
 #[derive(Debug)]
@@ -102,6 +111,79 @@ impl Planner {
         }
         SourceRays::index_looks(&mut rays, &scenario);
         progress.advance(1);
+        Ok(Planner {
+            scenario,
+            stats,
+            rays,
+            grid,
+            precompute_ms: started.elapsed().as_secs_f64() * 1e3,
+        })
+    }
+
+    /// What [`Planner::precompute`] computed (its statistics, rays and
+    /// indexes), as bytes that [`Planner::from_precomputed`] reads back to
+    /// the bit. Headed by [`PRECOMPUTED_FORMAT`] and the scenario's id.
+    pub fn encode_precomputed(&self) -> Vec<u8> {
+        let mut w = Writer::new();
+        w.bytes(PRECOMPUTED_MAGIC);
+        w.u64(PRECOMPUTED_FORMAT.into());
+        w.bytes(self.scenario.id.as_bytes());
+        w.len(self.stats.len());
+        self.stats.iter().for_each(|s| s.encode(&mut w));
+        w.len(self.rays.len());
+        self.rays.iter().for_each(|r| r.encode(&mut w));
+        w.bool(self.grid.is_some());
+        if let Some(grid) = &self.grid {
+            grid.encode(&mut w);
+        }
+        w.finish()
+    }
+
+    /// The planner of `scenario` from [`Planner::encode_precomputed`]'s
+    /// bytes, the same as [`Planner::new`] would compute.
+    ///
+    /// # Errors
+    /// A [`CodecError`] when the bytes are of another format or scenario,
+    /// or not such bytes at all.
+    pub fn from_precomputed(scenario: Scenario, bytes: &[u8]) -> Result<Self, CodecError> {
+        let started = Instant::now();
+        let mut r = Reader::new(bytes);
+        if r.bytes()? != PRECOMPUTED_MAGIC {
+            return Err(CodecError("not a precomputation".into()));
+        }
+        let format = r.u64()?;
+        if format != u64::from(PRECOMPUTED_FORMAT) {
+            return Err(CodecError(format!(
+                "format {format}, this server reads {PRECOMPUTED_FORMAT}"
+            )));
+        }
+        let id = r.bytes()?;
+        if id != scenario.id.as_bytes() {
+            return Err(CodecError(format!(
+                "the precomputation of {}, not of {}",
+                String::from_utf8_lossy(id),
+                scenario.id
+            )));
+        }
+        let n = r.len()?;
+        expect_len("statistics", n, scenario.fovs.len())?;
+        let cells = scenario.cell_count();
+        let stats = (0..n)
+            .map(|_| Stats::decode(&mut r, cells))
+            .collect::<Result<Vec<_>, _>>()?;
+        let n = r.len()?;
+        if n > scenario.sources.len() {
+            return Err(CodecError(format!("{n} rays for fewer sources")));
+        }
+        let rays = (0..n)
+            .map(|_| SourceRays::decode(&mut r, &scenario))
+            .collect::<Result<Vec<_>, _>>()?;
+        let grid = if r.bool()? {
+            Some(ElementaryGrid::decode(&mut r, &scenario)?)
+        } else {
+            None
+        };
+        r.end()?;
         Ok(Planner {
             scenario,
             stats,

@@ -10,6 +10,7 @@ mod first;
 mod rays;
 mod seen;
 mod sighted;
+mod stored;
 #[cfg(test)]
 mod tests;
 mod windows;

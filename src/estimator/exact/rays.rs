@@ -74,14 +74,14 @@ pub struct SourceRays {
 pub(super) struct LookCrossings {
     /// Per [`LookKey`]: the first ray of the range, and where its intervals
     /// start in `pq` (one entry more: the end of the last).
-    first: Vec<u32>,
-    start: Vec<u32>,
-    pq: Vec<(f64, f64)>,
+    pub(super) first: Vec<u32>,
+    pub(super) start: Vec<u32>,
+    pub(super) pq: Vec<(f64, f64)>,
     /// Per [`LookKey`]: how far its intervals must be pushed (at least,
     /// less a margin for rounding) to start past the exit of every ray
     /// they lie on ([`SourceRays::beyond`]); `+∞` when never (a ray that
     /// never leaves the zone), 0 for a look that meets no ray.
-    past: Vec<f64>,
+    pub(super) past: Vec<f64>,
 }
 
 /// A cell's field of view in [`LookCrossings`]: `slot · cells + index`.
@@ -171,16 +171,16 @@ pub(super) fn slab(r: &Rect, o: Point, inv: Point) -> (f64, f64) {
 /// instead of a grid walk, at every step of every request.
 #[derive(Debug, Clone)]
 pub(super) struct Crossings {
-    offsets: Vec<u32>,
-    r: Vec<f64>,
-    cells: Vec<[u32; 2]>,
+    pub(super) offsets: Vec<u32>,
+    pub(super) r: Vec<f64>,
+    pub(super) cells: Vec<[u32; 2]>,
     /// `cells[k]` as an index into the whole grid, `b·nx + a`.
-    lin: Vec<u32>,
+    pub(super) lin: Vec<u32>,
     /// Per crossing, its rectangle's area correction: the rectangle's
     /// exact measure `∫∫ dr dα` from this source (within its cone) over the
     /// measure the rays sample there, `step · Σ` of their lengths inside it
     /// (see [`Crossings::area_correction`]).
-    kappa: Vec<f64>,
+    pub(super) kappa: Vec<f64>,
 }
 
 impl Crossings {
