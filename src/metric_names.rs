@@ -40,8 +40,14 @@ pub const SESSIONS_LIVE: &str = "vigil_sessions_live";
 /// Counter of sessions dropped, by `reason` (`idle`, `capacity`).
 pub const SESSIONS_EVICTED_TOTAL: &str = "vigil_sessions_evicted_total";
 
+/// Counter of registered scenarios' precomputations, by `outcome`
+/// (`loaded`: read from the database; `computed`: precomputed here under a
+/// claim; `stored`: written for the other replicas; `rejected`: a stored
+/// one this server could not use, computed again).
+pub const PRECOMPUTED_TOTAL: &str = "vigil_precomputed_total";
+
 /// Every metric above.
-pub const ALL: [&str; 16] = [
+pub const ALL: [&str; 17] = [
     HTTP_REQUESTS_TOTAL,
     HTTP_REQUESTS_IN_FLIGHT,
     HTTP_SHED_TOTAL,
@@ -58,6 +64,7 @@ pub const ALL: [&str; 16] = [
     CONNECTIONS_CLOSED_TOTAL,
     SESSIONS_LIVE,
     SESSIONS_EVICTED_TOTAL,
+    PRECOMPUTED_TOTAL,
 ];
 
 #[cfg(test)]

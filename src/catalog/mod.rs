@@ -9,6 +9,8 @@
 //!   pools and the background jobs;
 //! - [`cache`]: planners bounded by memory (inline scenarios, and the
 //!   PostgreSQL catalogue's scenarios used here);
+//! - `shared`: with a database, each registered scenario precomputed once
+//!   for every replica, and loaded by the others;
 //! - `watch`: following deletions made through other replicas;
 //! - [`error`]: what it fails with ([`CatalogError`]).
 //!
@@ -19,6 +21,7 @@ pub mod cache;
 pub mod error;
 pub mod jobs;
 pub mod registry;
+mod shared;
 mod watch;
 
 pub use cache::PlannerCache;

@@ -37,6 +37,7 @@ use super::jobs::{
     Entry, Job, JobLimits, JobStatus, Pool, entry_id, precompute, precompute_on,
     predicted_precompute_ms,
 };
+use super::shared;
 use crate::metric_names;
 use crate::planner::Planner;
 use crate::scenario::{BUILTIN_IDS, Scenario, builtins};
@@ -73,6 +74,9 @@ struct Database {
     evictions: AtomicU64,
     /// One load per id at a time; the others wait and find it held.
     loading: Mutex<HashMap<String, Arc<tokio::sync::Mutex<()>>>>,
+    /// The runtime its calls run on, for the precomputation jobs' threads
+    /// ([`shared::obtain`]); `None` when made outside one.
+    runtime: Option<tokio::runtime::Handle>,
 }
 
 /// One scenario of the catalogue, as [`Registry::catalogue`] lists it.
@@ -130,6 +134,7 @@ impl Registry {
             cache: PlannerCache::new(cache_bytes),
             evictions: AtomicU64::new(0),
             loading: Mutex::new(HashMap::new()),
+            runtime: tokio::runtime::Handle::try_current().ok(),
         };
         Self::from_parts(scenarios, None, Some(db), limits)
     }
@@ -368,7 +373,15 @@ impl Registry {
             let status = self.entry(id).and_then(|(_, status)| status);
             return Ok((entry, status));
         }
-        let planner = tokio::task::spawn_blocking(move || precompute(scenario)).await?;
+        let planner = match shared::load(&db.store, &scenario).await {
+            Some(planner) => Arc::new(planner),
+            None => {
+                let planner =
+                    Arc::new(tokio::task::spawn_blocking(move || precompute(scenario)).await?);
+                shared::save_later(&db.store, planner.clone());
+                planner
+            }
+        };
         tracing::info!(%id, precompute_ms = planner.precompute_ms, "loaded a stored scenario");
         // Deleted while it was read or precomputed: its notification may
         // have come before it was held, so ask the table again.
@@ -382,7 +395,7 @@ impl Registry {
                 return Err(CatalogError::NotFound(id.to_owned()));
             }
         }
-        Ok((Entry::Ready(self.hold(db, Arc::new(planner))), None))
+        Ok((Entry::Ready(self.hold(db, planner)), None))
     }
 
     /// Keeps a ready planner of a registered scenario in the database's
@@ -504,6 +517,9 @@ impl Registry {
                 .insert(&planner.scenario)
                 .await
                 .map_err(CatalogError::from)?;
+            if created {
+                shared::save_later(&db.store, planner.clone());
+            }
             return Ok((Entry::Ready(self.hold(db, planner)), created));
         }
         let registry = self.clone();
@@ -621,7 +637,15 @@ impl Registry {
         let id = job.scenario.id.clone();
         tracing::info!(%id, predicted_ms = job.predicted_ms, "precompute job started");
         let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            precompute_on(Pool::Jobs, job.scenario.clone(), &job.cancel, &job.progress)
+            let scenario = job.scenario.clone();
+            match &self.shared.db {
+                Some(Database {
+                    store,
+                    runtime: Some(runtime),
+                    ..
+                }) => shared::obtain(runtime, store, scenario, &job.cancel, &job.progress),
+                _ => precompute_on(Pool::Jobs, scenario, &job.cancel, &job.progress),
+            }
         }));
         {
             let mut state = self.write();

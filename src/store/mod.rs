@@ -10,13 +10,14 @@
 //!   The schema comes from the migrations under `migrations/`, applied at
 //!   start; deletions are pushed to every replica with LISTEN/NOTIFY.
 //!
-//! With a database, sessions are kept there too ([`sessions`]).
-//!
-//! Either way only the spec is kept (with its id, and in PostgreSQL its
-//! creation time): statistics are rebuilt by each replica from the spec.
+//! The file store keeps only each spec (statistics are rebuilt from it at
+//! start). With a database, the catalogue keeps each spec with its
+//! creation time, what a replica precomputed for it ([`precomputed`]) so
+//! that the others load it instead, and the sessions ([`sessions`]).
 
 pub mod file;
 pub mod postgres;
+pub mod precomputed;
 pub mod sessions;
 
 pub use file::{FORMAT, Store};

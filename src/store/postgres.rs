@@ -161,7 +161,7 @@ impl PgStore {
         self.within(limit, call).await
     }
 
-    async fn within<T>(
+    pub(super) async fn within<T>(
         &self,
         limit: Duration,
         call: impl Future<Output = Result<T, sqlx::Error>>,

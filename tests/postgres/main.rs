@@ -10,6 +10,7 @@
 #![allow(clippy::unwrap_used)]
 
 mod cluster;
+mod precomputed;
 mod server;
 mod sessions;
 mod tests;

@@ -10,6 +10,7 @@ use sqlx::Connection;
 
 use crate::Test;
 use crate::cluster::Cluster;
+use crate::precomputed;
 use crate::server::{Server, assert_unavailable, body, spec};
 use crate::sessions;
 
@@ -49,6 +50,12 @@ pub const ALL: &[(&str, Test)] = &[
     }),
     ("session_bounds_across_replicas", |c| {
         Box::pin(sessions::session_bounds_across_replicas(c))
+    }),
+    ("precomputed_once_across_replicas", |c| {
+        Box::pin(precomputed::precomputed_once_across_replicas(c))
+    }),
+    ("precomputed_rows_are_whole_and_checked", |c| {
+        Box::pin(precomputed::precomputed_rows_are_whole_and_checked(c))
     }),
     ("database_outage", |c| Box::pin(database_outage(c))),
 ];
