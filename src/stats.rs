@@ -53,6 +53,16 @@ pub struct Stats {
     pub expected_targets_in_zone: f64,
 }
 
+/// Each cell's escape time, `d_hat / lambda_hat` (0 where no target
+/// enters).
+fn escape_times(lambda_hat: &[f64], d_hat: &[f64]) -> Vec<f64> {
+    lambda_hat
+        .iter()
+        .zip(d_hat)
+        .map(|(&l, &d)| if l > 0.0 { d / l } else { 0.0 })
+        .collect()
+}
+
 /// Angular span `[lo, hi]` (takeoff angles of the source's cone) of the
 /// rays from `source` that meet `region`, or `None` when it is degenerate.
 pub fn angular_span(source: &Source, region: &Region, buf: &mut Vec<Point>) -> Option<(f64, f64)> {
@@ -234,8 +244,8 @@ fn sighted_cell_rates(
 impl Stats {
     /// Writes these statistics ([`crate::codec`]).
     pub fn encode(&self, w: &mut Writer) {
+        // The escape times follow from the other two, to the bit.
         w.f64s(&self.lambda_hat);
-        w.f64s(&self.escape_time);
         w.f64s(&self.d_hat);
         w.f64(self.expected_targets_in_zone);
     }
@@ -245,16 +255,16 @@ impl Stats {
     /// # Errors
     /// A [`CodecError`] for bytes that are not such statistics.
     pub fn decode(r: &mut Reader, cells: usize) -> Result<Self, CodecError> {
-        let stats = Stats {
-            lambda_hat: r.f64s()?,
-            escape_time: r.f64s()?,
-            d_hat: r.f64s()?,
+        let lambda_hat = r.f64s()?;
+        let d_hat = r.f64s()?;
+        expect_len("lambda_hat", lambda_hat.len(), cells)?;
+        expect_len("d_hat", d_hat.len(), cells)?;
+        Ok(Stats {
+            escape_time: escape_times(&lambda_hat, &d_hat),
+            lambda_hat,
+            d_hat,
             expected_targets_in_zone: r.f64()?,
-        };
-        expect_len("lambda_hat", stats.lambda_hat.len(), cells)?;
-        expect_len("escape_time", stats.escape_time.len(), cells)?;
-        expect_len("d_hat", stats.d_hat.len(), cells)?;
-        Ok(stats)
+        })
     }
 
     /// Computes the statistics of every cell for the type `default`'s view
@@ -328,11 +338,7 @@ impl Stats {
             })
             .sum();
         let (lambda_hat, d_hat): (Vec<f64>, Vec<f64>) = per_cell.into_iter().unzip();
-        let escape_time = lambda_hat
-            .iter()
-            .zip(&d_hat)
-            .map(|(&l, &d)| if l > 0.0 { d / l } else { 0.0 })
-            .collect();
+        let escape_time = escape_times(&lambda_hat, &d_hat);
         Ok(Stats {
             lambda_hat,
             escape_time,

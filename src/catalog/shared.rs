@@ -45,6 +45,7 @@ pub(super) async fn load(store: &PgStore, scenario: &Scenario) -> Option<Planner
         }
     };
     let compressed = stored.compressed_bytes();
+    let fetch_ms = started.elapsed().as_secs_f64() * 1e3;
     let scenario = scenario.clone();
     let decoded = tokio::task::spawn_blocking(move || {
         if stored.format != PRECOMPUTED_FORMAT as i32 {
@@ -53,14 +54,22 @@ pub(super) async fn load(store: &PgStore, scenario: &Scenario) -> Option<Planner
                 stored.format
             ));
         }
+        let unpacking = Instant::now();
         let raw = stored.decompress()?;
-        Planner::from_precomputed(scenario, &raw).map_err(|e| e.to_string())
+        let unpack_ms = unpacking.elapsed().as_secs_f64() * 1e3;
+        let planner = Planner::from_precomputed(scenario, &raw).map_err(|e| e.to_string())?;
+        tracing::debug!(
+            unpack_ms,
+            decode_ms = planner.precompute_ms,
+            "decoded a stored precomputation"
+        );
+        Ok(planner)
     })
     .await
     .unwrap_or_else(|e| Err(format!("decoding failed: {e}")));
     match decoded {
         Ok(planner) => {
-            tracing::info!(%id, compressed, load_ms = started.elapsed().as_secs_f64() * 1e3, "loaded a stored precomputation");
+            tracing::info!(%id, compressed, fetch_ms, load_ms = started.elapsed().as_secs_f64() * 1e3, "loaded a stored precomputation");
             count("loaded");
             Some(planner)
         }

@@ -3,8 +3,10 @@
 //! `precomputed` in `migrations/`.
 //!
 //! - **Bytes.** [`Planner::encode_precomputed`](crate::planner::Planner::encode_precomputed)'s
-//!   bytes, compressed with zstd (with its checksum, so a corrupt chunk is
-//!   found on reading) and cut in chunks of [`CHUNK_BYTES`].
+//!   bytes, cut in chunks of [`RAW_CHUNK_BYTES`], each byte-shuffled and
+//!   compressed with zstd on its own (with its checksum, so a corrupt
+//!   chunk is found on reading), so that they are (de)compressed in
+//!   parallel.
 //! - **Once.** A replica about to precompute takes a claim
 //!   ([`PgStore::claim_precompute`]), a session-level advisory lock on a
 //!   connection of its own: another replica that finds it taken waits for
@@ -18,12 +20,14 @@
 
 use std::time::Duration;
 
+use rayon::prelude::*;
 use sqlx::{Connection, PgConnection};
 
 use super::{DbError, PgStore};
 
-/// The size of a stored chunk, compressed.
-pub const CHUNK_BYTES: usize = 8 << 20;
+/// Raw bytes per stored chunk (a multiple of 8, see [`shuffle`]); each is
+/// compressed on its own.
+pub const RAW_CHUNK_BYTES: usize = 8 << 20;
 
 /// Time limit of reading or writing a stored precomputation.
 pub const TRANSFER_TIMEOUT: Duration = Duration::from_secs(600);
@@ -42,42 +46,68 @@ pub struct Stored {
     pub format: i32,
     /// Its size uncompressed.
     pub raw_bytes: usize,
-    /// Its chunks, in order.
+    /// Its chunks, in order: chunk `k` holds raw bytes from
+    /// `k·RAW_CHUNK_BYTES` on.
     pub chunks: Vec<Vec<u8>>,
 }
 
 impl Stored {
-    /// `raw` compressed and cut in chunks.
+    /// `raw` cut in chunks of [`RAW_CHUNK_BYTES`], each byte-shuffled and
+    /// compressed on its own (in parallel).
     ///
     /// # Errors
     /// A message if zstd fails.
     pub fn compress(format: i32, raw: &[u8]) -> Result<Self, String> {
-        let mut encoder = zstd::Encoder::new(Vec::new(), LEVEL).map_err(|e| e.to_string())?;
-        encoder.include_checksum(true).map_err(|e| e.to_string())?;
-        std::io::Write::write_all(&mut encoder, raw).map_err(|e| e.to_string())?;
-        let packed = encoder.finish().map_err(|e| e.to_string())?;
+        let chunks = raw
+            .par_chunks(RAW_CHUNK_BYTES)
+            .map(|piece| {
+                let mut shuffled = vec![0; piece.len()];
+                shuffle(piece, &mut shuffled);
+                let mut zstd = zstd::bulk::Compressor::new(LEVEL).map_err(|e| e.to_string())?;
+                zstd.set_parameter(zstd::stream::raw::CParameter::ChecksumFlag(true))
+                    .map_err(|e| e.to_string())?;
+                zstd.compress(&shuffled).map_err(|e| e.to_string())
+            })
+            .collect::<Result<Vec<_>, String>>()?;
         Ok(Stored {
             format,
             raw_bytes: raw.len(),
-            chunks: packed.chunks(CHUNK_BYTES).map(<[u8]>::to_vec).collect(),
+            chunks,
         })
     }
 
-    /// The bytes [`Stored::compress`] was given.
+    /// The bytes [`Stored::compress`] was given (chunks decompressed in
+    /// parallel).
     ///
     /// # Errors
     /// A message for chunks that are not whole zstd data of `raw_bytes`
     /// (corrupt, truncated, or of another size).
     pub fn decompress(&self) -> Result<Vec<u8>, String> {
-        let packed = self.chunks.concat();
-        let raw = zstd::stream::decode_all(packed.as_slice()).map_err(|e| e.to_string())?;
-        if raw.len() != self.raw_bytes {
+        if self.chunks.len() != self.raw_bytes.div_ceil(RAW_CHUNK_BYTES) {
             return Err(format!(
-                "{} bytes uncompressed, {} recorded",
-                raw.len(),
+                "{} chunks for {} bytes",
+                self.chunks.len(),
                 self.raw_bytes
             ));
         }
+        let mut raw = vec![0; self.raw_bytes];
+        raw.par_chunks_mut(RAW_CHUNK_BYTES)
+            .zip(self.chunks.par_iter())
+            .try_for_each_init(
+                // One buffer per thread: fresh memory costs page faults.
+                || (zstd::bulk::Decompressor::new(), vec![0; RAW_CHUNK_BYTES]),
+                |(zstd, shuffled), (piece, packed)| {
+                    let zstd = zstd.as_mut().map_err(|e| e.to_string())?;
+                    let n = zstd
+                        .decompress_to_buffer(packed, shuffled.as_mut_slice())
+                        .map_err(|e| e.to_string())?;
+                    if n != piece.len() {
+                        return Err(format!("a chunk of {n} bytes, {} expected", piece.len()));
+                    }
+                    unshuffle(&shuffled[..n], piece);
+                    Ok(())
+                },
+            )?;
         Ok(raw)
     }
 
@@ -85,6 +115,31 @@ impl Stored {
     pub fn compressed_bytes(&self) -> usize {
         self.chunks.iter().map(Vec::len).sum()
     }
+}
+
+/// Groups the bytes of `src`'s 8-byte words by position (every word's
+/// first byte, then every second, …; a tail of fewer than 8 bytes kept as
+/// is): the sign and exponent bytes of nearby `f64` repeat, and zstd finds
+/// them together.
+fn shuffle(src: &[u8], dst: &mut [u8]) {
+    let n = src.len() / 8;
+    for (i, word) in src.chunks_exact(8).enumerate() {
+        for (b, &byte) in word.iter().enumerate() {
+            dst[b * n + i] = byte;
+        }
+    }
+    dst[8 * n..].copy_from_slice(&src[8 * n..]);
+}
+
+/// The inverse of [`shuffle`].
+fn unshuffle(src: &[u8], dst: &mut [u8]) {
+    let n = src.len() / 8;
+    for (i, word) in dst.chunks_exact_mut(8).enumerate() {
+        for (b, byte) in word.iter_mut().enumerate() {
+            *byte = src[b * n + i];
+        }
+    }
+    dst[8 * n..].copy_from_slice(&src[8 * n..]);
 }
 
 /// A claim on precomputing one scenario, held until released or dropped
@@ -230,10 +285,11 @@ mod tests {
 
     #[test]
     fn compressed_bytes_come_back_and_corruption_is_found() {
-        let raw: Vec<u8> = (0..3 * CHUNK_BYTES / 2)
+        let raw: Vec<u8> = (0..3 * RAW_CHUNK_BYTES / 2 + 5)
             .map(|i| (i * 7 % 251) as u8)
             .collect();
         let stored = Stored::compress(1, &raw).unwrap();
+        assert_eq!(stored.chunks.len(), 2);
         assert_eq!(stored.decompress().unwrap(), raw);
         let mut bad = Stored {
             chunks: stored.chunks.clone(),
