@@ -4,10 +4,13 @@
 //!   expired sessions are dropped at the next session request.
 //! - **In the database** (`--database-url`, [`crate::store::sessions`]):
 //!   every replica serves every session. This replica's memory holds only
-//!   a cache of sessions it served, bounded in bytes; a step checks its
-//!   cached state against the row's version and reloads it when another
-//!   replica moved it on, and is acknowledged only once stored over the
-//!   version it was made from ([`SessionStore::save`]).
+//!   a cache of sessions it served, bounded in bytes. A step is
+//!   acknowledged only once stored over the version it was made from
+//!   ([`SessionStore::save`]). It is made from the cached state, one round
+//!   trip to the database in all, while no other replica moves the session
+//!   on; once one did (the store failed), each step first checks the
+//!   cached state against the row's version and reloads it if needed, until
+//!   a check finds nobody moved it.
 //!
 //! Either way a step answered for an `Idempotency-Key` is answered again,
 //! unchanged, to a retry with that key ([`Refreshed::Replay`]).
@@ -39,8 +42,12 @@ pub struct Held {
     /// The state may differ from the stored one (a step made here was not
     /// stored): reload it whatever the version.
     stale: bool,
-    /// In memory: the last step's Idempotency-Key and answer.
+    /// The last step this replica made, its Idempotency-Key and answer.
     last: Option<(String, Bytes)>,
+    /// In the database: a step of another replica was stored over one
+    /// made here, so look at the row before making the next (a session
+    /// served by one replica at a time makes its steps from the cache).
+    shared: bool,
 }
 
 /// What a step or a read finds ([`SessionStore::refresh`]).
@@ -275,7 +282,11 @@ impl SessionStore {
         touch: bool,
         resolve: impl AsyncFnOnce(String, Vec<u8>) -> Result<Arc<Planner>, ApiError>,
     ) -> Result<Refreshed<'a>, ApiError> {
-        let Some(db) = &self.db else {
+        let cached = held.session.is_some() && !held.stale;
+        let Some(db) = self.db.as_ref().filter(|_| touch || !cached || held.shared) else {
+            // In memory, or a cached state that no other replica moved on
+            // lately: the step is made from it, and its compare-and-set
+            // finds out if another replica moved it after all.
             if let (Some(key), Some((last, answer))) = (key, &held.last)
                 && key == last
             {
@@ -286,7 +297,7 @@ impl SessionStore {
                 None => Err(self.not_found(id)),
             };
         };
-        let have = (!held.stale && held.session.is_some()).then_some(held.version);
+        let have = cached.then_some(held.version);
         let row = db
             .load_session(id, self.ttl, have, held.session.is_none(), key, touch)
             .await?;
@@ -335,6 +346,10 @@ impl SessionStore {
             })?;
             self.resize(id, session.memory_bytes());
             held.session = Some(session);
+            held.last = None;
+        } else {
+            // Nobody moved it since: make the next steps from the cache.
+            held.shared = false;
         }
         held.version = row.version;
         held.stale = false;
@@ -388,7 +403,10 @@ impl SessionStore {
         if stored {
             held.version += 1;
             held.stale = false;
-            self.resize(id, bytes);
+            held.last = key.map(|k| (k.to_owned(), answer.clone()));
+            self.resize(id, bytes + answer.len());
+        } else {
+            held.shared = true;
         }
         Ok(stored)
     }
