@@ -65,6 +65,9 @@ pub struct SessionTarget {
     pub sessions_url: String,
     /// `{base}/v1/sessions/{id}/step`, for messages.
     pub step_url: String,
+    /// The replicas' base URLs: step `j` of session `i` goes to
+    /// `bases[(i + j) % len]`, as a plain load balancer spreads them.
+    pub bases: Vec<String>,
     /// Body of `POST /v1/sessions`: the scenario and the settings.
     pub create: Bytes,
     /// Step bodies replayed untimed into every new session, in order.
@@ -102,6 +105,7 @@ impl Target {
     /// If there is no step or no session.
     pub fn session(
         base: &str,
+        also: &[String],
         scenario: &str,
         settings: &SessionSettings,
         warmup: &[StepRequest],
@@ -125,9 +129,14 @@ impl Target {
                 .collect()
         };
         let base = base.trim_end_matches('/');
+        let bases = std::iter::once(base)
+            .chain(also.iter().map(|b| b.trim_end_matches('/')))
+            .map(str::to_owned)
+            .collect();
         Ok(Target::Session(Arc::new(SessionTarget {
             sessions_url: format!("{base}/v1/sessions"),
             step_url: format!("{base}/v1/sessions/{{id}}/step"),
+            bases,
             create: Bytes::from(serde_json::to_vec(&create)?),
             warmup: bodies(warmup)?,
             steps: bodies(steps)?,
@@ -396,6 +405,8 @@ struct SessionSlot {
     url: String,
     /// `{base}/v1/sessions/{id}/step`.
     step_url: String,
+    /// The same on every replica ([`SessionTarget::bases`]).
+    step_urls: Vec<String>,
     /// Steps finished (answered, failed or given up), in order: step `j`
     /// is sent once this reaches `j`.
     done: tokio::sync::watch::Sender<u64>,
@@ -433,6 +444,11 @@ async fn open_sessions(
                 let url = format!("{}/{id}", t.sessions_url);
                 slots.push(SessionSlot {
                     step_url: format!("{url}/step"),
+                    step_urls: t
+                        .bases
+                        .iter()
+                        .map(|b| format!("{b}/v1/sessions/{id}/step"))
+                        .collect(),
                     url,
                     done: tokio::sync::watch::Sender::new(0),
                 });
@@ -548,6 +564,7 @@ pub async fn preflight(target: &Target, api_key: Option<&str>, timeout: Duration
         let one = Arc::new(SessionTarget {
             sessions_url: t.sessions_url.clone(),
             step_url: t.step_url.clone(),
+            bases: t.bases.clone(),
             create: t.create.clone(),
             warmup: Vec::new(),
             steps: Vec::new(),
@@ -836,7 +853,8 @@ impl Worker {
                         let w = Instant::now().saturating_duration_since(taken);
                         lock(&recorder).session_wait.saturating_record(micros(w));
                     }
-                    Some((slot, step, t.steps[body].clone()))
+                    let url = &slot.step_urls[(k + step as usize) % slot.step_urls.len()];
+                    Some((slot, url, step, t.steps[body].clone()))
                 }
                 _ => None,
             };
@@ -846,7 +864,7 @@ impl Worker {
                 None
             } else {
                 let rb = match &slot {
-                    Some((slot, _, body)) => post(&client, &slot.step_url, body.clone()),
+                    Some((_, url, _, body)) => post(&client, url, body.clone()),
                     None => request(&client, &target, job.seq, None),
                 };
                 Some(
@@ -863,7 +881,7 @@ impl Worker {
                 )
             };
             let done = Instant::now();
-            if let Some((slot, step, _)) = &slot {
+            if let Some((slot, _, step, _)) = &slot {
                 slot.done.send_replace(step + 1);
             }
             let mut r = lock(&recorder);

@@ -254,6 +254,12 @@ struct RunArgs {
     /// Base URL of the server (http only).
     #[arg(long, default_value = "http://127.0.0.1:8080")]
     url: String,
+    /// With `--endpoint session`: the base URL of another replica on the
+    /// same database (repeat for more). Sessions are opened through
+    /// `--url`; step `j` of session `i` goes to replica `(i + j) mod n`, as
+    /// a plain load balancer spreads them.
+    #[arg(long)]
+    also_url: Vec<String>,
     /// Endpoint to load.
     #[arg(long, value_enum, default_value_t = Endpoint::Plan)]
     endpoint: Endpoint,
@@ -599,6 +605,9 @@ fn run_cmd(a: &RunArgs) -> Result<()> {
     if a.threads == 0 {
         bail!("--threads must be at least 1");
     }
+    if !a.also_url.is_empty() && a.endpoint != Endpoint::Session {
+        bail!("--also-url spreads the steps of sessions: it needs --endpoint session");
+    }
     let target = match a.endpoint {
         Endpoint::Healthz => Target::healthz(&a.url),
         Endpoint::Plan => {
@@ -618,6 +627,7 @@ fn run_cmd(a: &RunArgs) -> Result<()> {
             let (_, wl) = a.workload.session(&planner)?;
             Target::session(
                 &a.url,
+                &a.also_url,
                 &a.workload.scenario,
                 &wl.settings,
                 &wl.warmup,

@@ -29,6 +29,8 @@ struct Seen {
     sessions: Mutex<HashMap<String, (Vec<String>, bool)>>,
     overlaps: AtomicU64,
     deleted: AtomicU64,
+    /// Per session: which listener served each step.
+    served_by: Mutex<HashMap<String, Vec<usize>>>,
 }
 
 /// A server with the session routes: each step takes `service` plus a few
@@ -36,7 +38,33 @@ struct Seen {
 /// arrive while their session is busy.
 async fn fake_sessions(service: Duration) -> (String, Arc<Seen>) {
     let seen = Arc::new(Seen::default());
-    let app = Router::new()
+    let base = listen(fake_app(&seen, service, 0)).await;
+    (base, seen)
+}
+
+/// `replicas` fake servers sharing their sessions, as replicas on one
+/// database do.
+async fn fake_replicas(service: Duration, replicas: usize) -> (Vec<String>, Arc<Seen>) {
+    let seen = Arc::new(Seen::default());
+    let mut bases = Vec::new();
+    for i in 0..replicas {
+        bases.push(listen(fake_app(&seen, service, i)).await);
+    }
+    (bases, seen)
+}
+
+async fn listen(app: Router) -> String {
+    let listener = TcpListener::bind("127.0.0.1:0").await.expect("bind");
+    let addr = listener.local_addr().expect("addr");
+    tokio::spawn(async move {
+        axum::serve(listener, app).await.expect("serve");
+    });
+    format!("http://{addr}")
+}
+
+/// The fake server's routes, as listener `index` serves them.
+fn fake_app(seen: &Arc<Seen>, service: Duration, index: usize) -> Router {
+    Router::new()
         .route(
             "/v1/sessions",
             post(|State(seen): State<Arc<Seen>>| async move {
@@ -62,7 +90,14 @@ async fn fake_sessions(service: Duration) -> (String, Arc<Seen>) {
                         }
                         *busy = true;
                         bodies.push(body);
-                        bodies.len() as u64
+                        let n = bodies.len() as u64;
+                        seen.served_by
+                            .lock()
+                            .expect("lock")
+                            .entry(id.clone())
+                            .or_default()
+                            .push(index);
+                        n
                     };
                     let jitter = Duration::from_millis((n * 7 + id.len() as u64) % 13);
                     tokio::time::sleep(service + jitter).await;
@@ -85,20 +120,21 @@ async fn fake_sessions(service: Duration) -> (String, Arc<Seen>) {
                 }
             }),
         )
-        .with_state(Arc::clone(&seen));
-    let listener = TcpListener::bind("127.0.0.1:0").await.expect("bind");
-    let addr = listener.local_addr().expect("addr");
-    tokio::spawn(async move {
-        axum::serve(listener, app).await.expect("serve");
-    });
-    (format!("http://{addr}"), seen)
+        .with_state(Arc::clone(seen))
 }
 
 fn target(base: &str, warmup: usize, steps: usize, sessions: usize) -> Target {
+    replicated(&[base.to_owned()], warmup, steps, sessions)
+}
+
+/// Sessions opened through `bases[0]`, their steps spread over `bases`.
+fn replicated(bases: &[String], warmup: usize, steps: usize, sessions: usize) -> Target {
     let body = |s: String| Bytes::from(s);
+    let base = &bases[0];
     Target::Session(Arc::new(SessionTarget {
         sessions_url: format!("{base}/v1/sessions"),
         step_url: format!("{base}/v1/sessions/{{id}}/step"),
+        bases: bases.to_vec(),
         create: Bytes::from_static(b"{}"),
         warmup: (0..warmup).map(|i| body(format!("w{i}"))).collect(),
         steps: (0..steps).map(|i| body(format!("s{i}"))).collect(),
@@ -180,6 +216,26 @@ async fn each_session_walks_its_warm_up_then_its_steps_cycled() {
 /// One session, a 50 ms step, 100 steps/s offered over 4 connections: the
 /// steps run one at a time (20/s), and each one's wait for the previous
 /// counts in its latency, as queueing does: median ~1 s, not 50 ms.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn steps_spread_over_replicas_as_a_load_balancer_does() {
+    let (bases, seen) = fake_replicas(Duration::from_millis(1), 2).await;
+    let r = run(&config(replicated(&bases, 2, 5, 3), 200.0, 300, 8))
+        .await
+        .expect("a run");
+    assert_eq!(r.summary.errors, 0, "{}", r.describe());
+    assert_eq!(seen.overlaps.load(Ordering::SeqCst), 0);
+    let served = seen.served_by.lock().expect("lock").clone();
+    assert_eq!(served.len(), 3);
+    for (id, replicas) in &served {
+        // Warm-up through the first; then each step on the replica the
+        // step before was not.
+        assert_eq!(replicas[..2], [0, 0], "{id}");
+        let run = &replicas[2..];
+        assert!(run.len() >= 4, "{id}: {replicas:?}");
+        assert!(run.windows(2).all(|w| w[0] != w[1]), "{id}: {replicas:?}");
+    }
+}
+
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn the_wait_for_the_sessions_previous_step_counts_in_the_latency() {
     let (base, seen) = fake_sessions(Duration::from_millis(50)).await;
