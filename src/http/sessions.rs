@@ -8,13 +8,13 @@
 //! stored only over the state it was made from, and made again (up to
 //! [`STEP_ATTEMPTS`] times, then 409) when another step was stored first.
 
+use std::sync::Arc;
+
 use axum::Extension;
 use axum::body::Bytes;
 use axum::extract::State;
 use axum::http::{HeaderMap, HeaderValue, StatusCode, header};
 use axum::response::{IntoResponse, Response};
-use std::sync::Arc;
-
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 

@@ -18,8 +18,8 @@
 //!   pool's acquire timeout, the server-side `statement_timeout`, and a
 //!   timer around the whole call), so an unreachable database gives a
 //!   [`DbError`] quickly rather than a hang. The pool tests a connection
-//!   before handing it out and opens new ones as needed, so it recovers by
-//!   itself when the database returns. [`PgStore::is_up`] (and the gauge
+//!   idle for a second or more before handing it out and opens new ones as
+//!   needed, so it recovers by itself when the database returns. [`PgStore::is_up`] (and the gauge
 //!   `vigil_database_up`) says whether the last contact succeeded.
 //!
 //! Queries are checked at run time: building needs no database.
@@ -50,6 +50,9 @@ const WHILE_DOWN: Duration = Duration::from_millis(300);
 
 /// Connections in a replica's pool (the deletion listener holds one more).
 const POOL_SIZE: u32 = 8;
+
+/// A pooled connection idle this long is checked (a ping) before use.
+const CHECK_IDLE_AFTER: Duration = Duration::from_secs(1);
 
 /// Why a call to the database failed: it is unreachable, too slow, or
 /// refused the query. Every one is answered 503 with `Retry-After`.
@@ -119,7 +122,18 @@ impl PgStore {
             .max_connections(POOL_SIZE)
             .min_connections(0)
             .acquire_timeout(timeout)
-            .test_before_acquire(true)
+            // A connection idle for a while is checked before use, so the
+            // pool recovers by itself from a database restart; one in
+            // steady use is not, which saves a round trip per call.
+            .test_before_acquire(false)
+            .before_acquire(|conn, meta| {
+                Box::pin(async move {
+                    if meta.idle_for < CHECK_IDLE_AFTER {
+                        return Ok(true);
+                    }
+                    Ok(conn.ping().await.is_ok())
+                })
+            })
             .connect_lazy_with(options);
         let store = Self {
             pool,
