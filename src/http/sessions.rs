@@ -205,7 +205,7 @@ pub async fn create(
         ("Idempotency-Key" = Option<String>, Header, description = "Any string of 1 to 128 \
             visible ASCII characters naming this step (e.g. its number or a UUID): a retry \
             with the key of the session's last step gets that step's answer again instead of \
-            a new step.", min_length = 1, max_length = 128,
+            a new step.", min_length = 1,
             pattern = r"^[\x21-\x7E]([\x20-\x7E]*[\x21-\x7E])?$"),
     ),
     request_body(content = StepRequest, description = "Sensors and detections now.",

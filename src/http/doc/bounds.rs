@@ -7,10 +7,11 @@ use utoipa::openapi::schema::{ArrayItems, ObjectBuilder, Schema, Type};
 use utoipa::openapi::{OpenApi, RefOr};
 
 use crate::limits::{
-    MAX_BUDGET_MS, MAX_HISTORY_POSITIONS, MAX_HISTORY_STEPS, MAX_HORIZON, MAX_MIN_SEPARATION,
-    MAX_NAME_CHARS, MAX_NO_GO, MAX_OBSTACLE_VERTICES, MAX_OBSTACLES, MAX_RAYS_PER_PI,
-    MAX_SENSOR_SPEED, MAX_SENSOR_TYPES, MAX_SENSORS, MAX_SOURCES, MAX_SPEED_CLASSES, MAX_TARGETS,
-    MAX_TYPE_NAME_CHARS, MIN_OBSTACLE_VERTICES, MIN_RAYS_PER_PI,
+    MAX_BUDGET_MS, MAX_HISTORY_POSITIONS, MAX_HISTORY_STEPS, MAX_HORIZON,
+    MAX_IDEMPOTENCY_KEY_CHARS, MAX_MIN_SEPARATION, MAX_NAME_CHARS, MAX_NO_GO,
+    MAX_OBSTACLE_VERTICES, MAX_OBSTACLES, MAX_RAYS_PER_PI, MAX_SENSOR_SPEED, MAX_SENSOR_TYPES,
+    MAX_SENSORS, MAX_SOURCES, MAX_SPEED_CLASSES, MAX_TARGETS, MAX_TYPE_NAME_CHARS,
+    MIN_OBSTACLE_VERTICES, MIN_RAYS_PER_PI,
 };
 
 /// A bound on one property.
@@ -130,13 +131,24 @@ const RULES: &[(&[&str], &str, Bound)] = &[
     ),
 ];
 
-/// Writes every bound of `RULES`, and the count and the name pattern of a
-/// scenario's sensor types (a map, which the derive cannot bound).
+/// Writes every bound of `RULES`, the length of a step's `Idempotency-Key`,
+/// and the count and the name pattern of a scenario's sensor types (a map,
+/// which the derive cannot bound).
 #[derive(Debug)]
 pub struct Bounds;
 
 impl Modify for Bounds {
     fn modify(&self, doc: &mut OpenApi) {
+        // The session step's Idempotency-Key header.
+        let operations = doc.paths.paths.values_mut().filter_map(|p| p.post.as_mut());
+        for parameter in operations.flat_map(|o| o.parameters.iter_mut().flatten()) {
+            if let RefOr::T(parameter) = parameter
+                && parameter.name == "Idempotency-Key"
+                && let Some(RefOr::T(schema)) = parameter.schema.as_mut()
+            {
+                apply(schema, Bound::MaxLength(MAX_IDEMPOTENCY_KEY_CHARS));
+            }
+        }
         let Some(components) = doc.components.as_mut() else {
             return;
         };

@@ -5,6 +5,7 @@ use utoipa::ToResponse;
 
 use crate::catalog::JobStatus;
 use crate::http::error::{ApiError, Problem};
+use crate::limits::MAX_IDEMPOTENCY_KEY_CHARS;
 use crate::scenario::ValidationError;
 
 /// Description of the `{id}` path parameter.
@@ -88,7 +89,7 @@ pub struct SessionNotFound(pub Problem);
             "Failed to parse the request body as JSON: EOF while parsing an object at line 1 column 1".to_owned()
         ))))),
         ("idempotency-key" = (summary = "An Idempotency-Key too long", value = json!(problem(
-            ApiError::BadHeader("Idempotency-Key: must have 1 to 128 characters, not 200".to_owned())
+            ApiError::BadHeader(format!("Idempotency-Key: must have 1 to {MAX_IDEMPOTENCY_KEY_CHARS} characters, not 200"))
         )))),
     )
 )]
