@@ -157,24 +157,24 @@ impl<'a> Reader<'a> {
         self.take(n)
     }
 
+    /// An array of `N`-byte words, each made a value by `from`.
+    fn words<const N: usize, T>(&mut self, from: fn([u8; N]) -> T) -> Result<Vec<T>, CodecError> {
+        let n = self.count(N)?;
+        Ok(self
+            .take(N * n)?
+            .chunks_exact(N)
+            .map(|c| from(c.try_into().unwrap_or([0; N])))
+            .collect())
+    }
+
     /// An array of `f64`.
     pub fn f64s(&mut self) -> Result<Vec<f64>, CodecError> {
-        let n = self.count(8)?;
-        Ok(self
-            .take(8 * n)?
-            .chunks_exact(8)
-            .map(|c| f64::from_le_bytes(c.try_into().unwrap_or([0; 8])))
-            .collect())
+        self.words(f64::from_le_bytes)
     }
 
     /// An array of `u32`.
     pub fn u32s(&mut self) -> Result<Vec<u32>, CodecError> {
-        let n = self.count(4)?;
-        Ok(self
-            .take(4 * n)?
-            .chunks_exact(4)
-            .map(|c| u32::from_le_bytes(c.try_into().unwrap_or([0; 4])))
-            .collect())
+        self.words(u32::from_le_bytes)
     }
 
     /// An array of `usize`.
