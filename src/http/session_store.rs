@@ -37,7 +37,7 @@ pub type Shared = Arc<tokio::sync::Mutex<Held>>;
 pub struct Held {
     /// The state, once loaded.
     session: Option<Session>,
-    /// Steps stored (in the database: the row's version this state is).
+    /// In the database: the row's version this state is.
     version: i64,
     /// The state may differ from the stored one (a step made here was not
     /// stored): reload it whatever the version.
@@ -382,7 +382,6 @@ impl SessionStore {
         let bytes = session.memory_bytes();
         let Some(db) = &self.db else {
             held.last = key.map(|k| (k.to_owned(), answer.clone()));
-            held.version += 1;
             self.resize(id, bytes + answer.len());
             return Ok(true);
         };
