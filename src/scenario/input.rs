@@ -118,3 +118,24 @@ pub fn check_min_separation(
     d.map(|d| d.check(field, 0..=MAX_MIN_SEPARATION))
         .transpose()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Integer;
+
+    fn parse(text: &str) -> Option<u64> {
+        serde_json::from_str::<Integer>(text).unwrap().get()
+    }
+
+    #[test]
+    fn whole_numbers_written_with_a_point_are_integers() {
+        assert_eq!(parse("4.0"), Some(4));
+        assert_eq!(parse("4e0"), Some(4));
+        assert_eq!(parse("4.5"), None);
+        assert_eq!(parse("-1"), None);
+        // Sixteen digits and a point: parsed by inexact float arithmetic,
+        // this lands a fraction off the whole number it is.
+        assert_eq!(parse("2251799813685247.0"), Some(2_251_799_813_685_247));
+        assert_eq!(parse("9007199254740991.0"), Some(9_007_199_254_740_991));
+    }
+}
