@@ -280,7 +280,7 @@ impl<'p> Evaluator<'p> {
         cancel: &CancelToken,
     ) -> Result<Self, Cancelled> {
         Ok(Self {
-            est: planner.estimator(plan, cancel)?,
+            est: planner.estimator(plan, cancel, None)?,
             planner,
             plan,
         })

@@ -16,7 +16,9 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use serde::{Deserialize, Serialize};
-use vigil::planner::{PlanRequest, PlanResponse, Planner};
+use vigil::cancel::CancelToken;
+use vigil::estimator::Carry;
+use vigil::planner::{PlanInput, PlanRequest, PlanResponse, Planner};
 use vigil::session::{Session, StepRequest};
 
 use crate::inproc::{InprocReport, from_nanos};
@@ -26,22 +28,29 @@ use crate::workload::SessionWorkload;
 /// `POST /v1/sessions/{id}/step`: a learning session's fold of the step
 /// ([`vigil::fit::RateLearner::fold`]), the stateless request of the
 /// session's state with this step ([`Session::prepare`]), its plan (at the
-/// learnt rates), and the step recorded ([`Session::commit`]). A step
-/// whose plan fails changes nothing.
+/// learnt rates, from and into the session's `carry`), and the step
+/// recorded ([`Session::commit`]). A step whose plan fails changes nothing
+/// but the carry.
 ///
 /// # Errors
 /// If the learner or the planner refuses the step.
-pub fn session_step(session: &mut Session, step: &StepRequest) -> Result<PlanResponse> {
+pub fn session_step(
+    session: &mut Session,
+    carry: &mut Carry,
+    step: &StepRequest,
+) -> Result<PlanResponse> {
     let learnt = session
         .learner()
         .map(|l| l.fold(&step.sensors, &step.detections))
         .transpose()
         .context("the learning session refused the step")?;
     let prepared = session.prepare(step);
-    let plan = session
-        .planner_for(learnt.as_ref())
-        .plan_request(&prepared.request)
+    let planner = session.planner_for(learnt.as_ref());
+    let input = PlanInput::new(&planner.scenario, &prepared.request)
         .context("the session's step was refused")?;
+    let plan = planner
+        .plan_carried(&input, &CancelToken::never(), carry)
+        .context("a plan that is never cancelled was cancelled")?;
     session.commit(prepared);
     if let Some(learnt) = learnt {
         session.commit_learnt(learnt);
@@ -49,16 +58,19 @@ pub fn session_step(session: &mut Session, step: &StepRequest) -> Result<PlanRes
     Ok(plan)
 }
 
-/// A fresh session of `workload` on `planner`, its warm-up steps replayed.
+/// A fresh session of `workload` on `planner`, its warm-up steps replayed,
+/// and the carry they left.
 ///
 /// # Errors
 /// If a warm-up step is refused (the error names it).
-pub fn warmed(planner: &Arc<Planner>, workload: &SessionWorkload) -> Result<Session> {
+pub fn warmed(planner: &Arc<Planner>, workload: &SessionWorkload) -> Result<(Session, Carry)> {
     let mut session = Session::new(Arc::clone(planner), workload.settings.clone());
+    let mut carry = Carry::new();
     for (i, step) in workload.warmup.iter().enumerate() {
-        session_step(&mut session, step).with_context(|| format!("warm-up step {i}"))?;
+        session_step(&mut session, &mut carry, step)
+            .with_context(|| format!("warm-up step {i}"))?;
     }
-    Ok(session)
+    Ok((session, carry))
 }
 
 /// In-process session step times, as `inproc --session --out` writes them:
@@ -119,7 +131,7 @@ pub fn measure(
     let mut plans: Vec<u64> = Vec::with_capacity(if stateless.is_some() { iterations } else { 0 });
     let mut sessions = 0;
     while steps.len() < iterations {
-        let mut session = warmed(planner, workload)?;
+        let (mut session, mut carry) = warmed(planner, workload)?;
         sessions += 1;
         for (k, step) in workload.steps.iter().enumerate() {
             if steps.len() == iterations {
@@ -141,7 +153,7 @@ pub fn measure(
                 plan(&mut plans)?;
             }
             let t = Instant::now();
-            let res = session_step(&mut session, black_box(step));
+            let res = session_step(&mut session, &mut carry, black_box(step));
             steps.push(nanos(t));
             black_box(res.with_context(|| format!("step {k}"))?);
             if !plan_first {

@@ -39,12 +39,12 @@ fn the_reference_sessions_plans_are_the_stateless_requests_plans() {
     assert_eq!(reqs, w.requests(&planner, count));
     assert_eq!(wl.steps.len(), count);
     assert!(wl.warmup.len() >= w.history, "{}", wl.warmup.len());
-    let mut session = warmed(&planner, &wl).expect("warm-up steps are valid");
+    let (mut session, mut carry) = warmed(&planner, &wl).expect("warm-up steps are valid");
     assert_eq!(session.history_held(), w.history);
     let mut targets = 0;
     for (k, (step, req)) in wl.steps.iter().zip(&reqs).enumerate() {
         let stateless = planner.plan_request(req).expect("valid request");
-        let via_session = session_step(&mut session, step).expect("valid step");
+        let via_session = session_step(&mut session, &mut carry, step).expect("valid step");
         assert_same_plan(k, &stateless, &via_session);
         targets += req.targets.len();
     }
@@ -52,7 +52,7 @@ fn the_reference_sessions_plans_are_the_stateless_requests_plans() {
     assert!(targets / count > 20, "{}", targets / count);
     // A step out of its place (the session already past it) no longer plans
     // as its stateless request: the check above can fail.
-    let replayed = session_step(&mut session, &wl.steps[0]).expect("valid step");
+    let replayed = session_step(&mut session, &mut carry, &wl.steps[0]).expect("valid step");
     let first = planner.plan_request(&reqs[0]).expect("valid request");
     let differs = (replayed.expected_detections - first.expected_detections).abs() > 1e-9
         || replayed

@@ -16,9 +16,9 @@ mod paper;
 
 pub use elementary::{ElementaryGrid, MAX_SMALL_GRID};
 pub use exact::{
-    ExactEstimator, FirstDetections, INDEX_CROSSINGS_PER_CELL, MIN_INDEX_CROSSINGS,
-    ONE_WINDOW_RECTANGLES, PathCover, Precomputed, RAYS_PER_PI, RAYS_PER_PI_SQUARE, Situation,
-    SourceRays,
+    Carry, CarryUse, ExactEstimator, FirstDetections, INDEX_CROSSINGS_PER_CELL,
+    MIN_INDEX_CROSSINGS, ONE_WINDOW_RECTANGLES, PathCover, Precomputed, RAYS_PER_PI,
+    RAYS_PER_PI_SQUARE, Situation, SourceRays,
 };
 pub use paper::PaperEstimator;
 

@@ -3,6 +3,7 @@
 //! T-step paths.
 
 use std::collections::HashSet;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 use super::input::PlanInput;
@@ -11,7 +12,7 @@ use crate::cancel::{CancelToken, Cancelled, Progress};
 use crate::codec::{CodecError, Reader, Writer, expect_len};
 use crate::coordination::{Fleet, Objective, coordinate};
 use crate::estimator::{
-    ElementaryGrid, Estimator, ExactEstimator, FirstDetections, PaperEstimator, Precomputed,
+    Carry, ElementaryGrid, Estimator, ExactEstimator, FirstDetections, PaperEstimator, Precomputed,
     Situation, SourceRays,
 };
 use crate::scenario::{Cell, Look, Scenario, ValidationError};
@@ -37,6 +38,16 @@ pub struct Planner {
     pub(crate) grid: Option<ElementaryGrid>,
     /// Time the precomputation took, milliseconds.
     pub precompute_ms: f64,
+    /// Which planner this is, for the carries it makes ([`Carry`]): no
+    /// two planners of one process share it, so a carry made by another
+    /// (another scenario, or other learnt rates) starts over.
+    identity: u64,
+}
+
+/// The next planner's [`Planner::identity`].
+fn next_identity() -> u64 {
+    static NEXT: AtomicU64 = AtomicU64::new(1);
+    NEXT.fetch_add(1, Ordering::Relaxed)
 }
 
 impl Planner {
@@ -84,6 +95,7 @@ impl Planner {
     /// studies that compare the two on the same states.
     pub fn plain_midpoint(mut self) -> Self {
         self.rays.iter_mut().for_each(SourceRays::plain_midpoint);
+        self.identity = next_identity();
         self
     }
 
@@ -117,6 +129,7 @@ impl Planner {
             rays,
             grid,
             precompute_ms: started.elapsed().as_secs_f64() * 1e3,
+            identity: next_identity(),
         })
     }
 
@@ -190,6 +203,7 @@ impl Planner {
             rays,
             grid,
             precompute_ms: started.elapsed().as_secs_f64() * 1e3,
+            identity: next_identity(),
         })
     }
 
@@ -259,6 +273,31 @@ impl Planner {
         self.plan_here(input, cancel)
     }
 
+    /// [`Planner::plan_cancellable`] for a step of a session whose last
+    /// step left `carry`: the exact estimator starts from what the carry
+    /// kept and keeps what the next step needs (see [`Carry`]). The plan
+    /// is the stateless plan of the same input, to rounding (1e-9 in the
+    /// tests). A cancelled plan leaves the carry empty.
+    ///
+    /// # Errors
+    /// [`Cancelled`] once `cancel` is cancelled.
+    pub fn plan_carried(
+        &self,
+        input: &PlanInput,
+        cancel: &CancelToken,
+        carry: &mut Carry,
+    ) -> Result<PlanResponse, Cancelled> {
+        let res = if rayon::current_thread_index().is_none() && rayon::current_num_threads() > 1 {
+            rayon::scope(|_| self.plan_with(input, cancel, Some(&mut *carry)))
+        } else {
+            self.plan_with(input, cancel, Some(&mut *carry))
+        };
+        if res.is_err() {
+            *carry = Carry::new();
+        }
+        res
+    }
+
     /// [`Planner::plan_cancellable`] on the calling thread: on a worker of
     /// a rayon pool the plan's parallel parts split among its workers; on
     /// any other thread they run there, one after the other. The answer is
@@ -272,10 +311,20 @@ impl Planner {
         input: &PlanInput,
         cancel: &CancelToken,
     ) -> Result<PlanResponse, Cancelled> {
+        self.plan_with(input, cancel, None)
+    }
+
+    /// [`Planner::plan_here`], from and into `carry` when given.
+    fn plan_with(
+        &self,
+        input: &PlanInput,
+        cancel: &CancelToken,
+        carry: Option<&mut Carry>,
+    ) -> Result<PlanResponse, Cancelled> {
         cancel.check()?;
         let started = Instant::now();
         let s = &self.scenario;
-        let est = self.estimator(input, cancel)?;
+        let est = self.estimator(input, cancel, carry)?;
         cancel.check()?;
         let result = est.with_fleet(s, input, cancel, |fleet| {
             coordinate(
@@ -341,23 +390,45 @@ impl Planner {
         &self,
         input: &PlanInput,
         cancel: &CancelToken,
+        carry: Option<&mut Carry>,
     ) -> Result<Chosen<'_>, Cancelled> {
         let s = &self.scenario;
         Ok(match input.estimator {
-            EstimatorKind::Paper => Chosen::Paper(PaperEstimator::new(
-                s,
-                &self.stats,
-                &input.starts,
-                &input.types,
-                &input.targets,
-                input.horizon,
-            )),
-            EstimatorKind::Exact => {
-                let est = self.exact_estimator(input, None);
-                cancel.check()?;
-                est.prepare();
-                Chosen::Exact(est)
-            }
+            EstimatorKind::Paper => Chosen::Paper({
+                if let Some(carry) = carry {
+                    // Nothing to carry: the paper's estimator keeps no
+                    // seen sets.
+                    *carry = Carry::new();
+                }
+                PaperEstimator::new(
+                    s,
+                    &self.stats,
+                    &input.starts,
+                    &input.types,
+                    &input.targets,
+                    input.horizon,
+                )
+            }),
+            EstimatorKind::Exact => match carry {
+                Some(carry) => {
+                    let observed = self.observed_looks(input);
+                    let est = ExactEstimator::carried(
+                        self.precomputed(None),
+                        self.situation(input, &observed),
+                        self.identity,
+                        carry,
+                    );
+                    cancel.check()?;
+                    est.prepare_carried(carry);
+                    Chosen::Exact(est)
+                }
+                None => {
+                    let est = self.exact_estimator(input, None);
+                    cancel.check()?;
+                    est.prepare();
+                    Chosen::Exact(est)
+                }
+            },
         })
     }
 
@@ -371,21 +442,29 @@ impl Planner {
         rays: Option<&'a [SourceRays]>,
     ) -> ExactEstimator<'a> {
         let observed = self.observed_looks(input);
-        ExactEstimator::new(
-            Precomputed {
-                scenario: &self.scenario,
-                stats: &self.stats,
-                rays: rays.unwrap_or(&self.rays),
-                grid: self.grid.as_ref(),
-            },
-            Situation {
-                observed: &observed,
-                targets: &input.targets,
-                starts: &input.starts,
-                types: &input.types,
-                horizon: input.horizon,
-            },
-        )
+        ExactEstimator::new(self.precomputed(rays), self.situation(input, &observed))
+    }
+
+    /// What the exact estimator reads of this planner, on `rays` instead
+    /// of its own when given.
+    fn precomputed<'a>(&'a self, rays: Option<&'a [SourceRays]>) -> Precomputed<'a> {
+        Precomputed {
+            scenario: &self.scenario,
+            stats: &self.stats,
+            rays: rays.unwrap_or(&self.rays),
+            grid: self.grid.as_ref(),
+        }
+    }
+
+    /// `input`'s sensors, targets and `observed` looks.
+    fn situation<'a>(&self, input: &'a PlanInput, observed: &'a [Vec<Look>]) -> Situation<'a> {
+        Situation {
+            observed,
+            targets: &input.targets,
+            starts: &input.starts,
+            types: &input.types,
+            horizon: input.horizon,
+        }
     }
 
     /// `O_s` for s = 0, 1, …: the looks taken now and in the history (the

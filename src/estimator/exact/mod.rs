@@ -5,6 +5,7 @@
 //! (seen sets along rays), [`windows`] (per-step unseen mass over the
 //! elementary grid) and, here, the per-cell values.
 
+mod carry;
 mod cell_sights;
 mod first;
 mod rays;
@@ -17,6 +18,7 @@ mod windows;
 
 use rayon::prelude::*;
 
+pub use carry::{Carry, CarryUse};
 pub use first::{FirstDetections, PathCover};
 use rays::{ClassRays, LookKey, look_key};
 pub use rays::{
@@ -155,19 +157,31 @@ impl<'a> ExactEstimator<'a> {
     /// left it, or have not entered and cannot have been seen. With a grid
     /// (square fields of view) values near the sensors use the fast path.
     pub fn new(precomputed: Precomputed<'a>, now: Situation<'_>) -> Self {
-        let Precomputed {
-            scenario,
-            stats,
-            rays,
-            grid,
-        } = precomputed;
-        let Situation {
-            observed,
-            targets,
-            starts,
-            types,
-            horizon,
-        } = now;
+        Self::build(precomputed, now, None)
+    }
+
+    /// [`ExactEstimator::new`], its seen sets (and, by
+    /// [`ExactEstimator::prepare_carried`], its windows) made from `carry`,
+    /// which a step of the same session left, and kept in it for the next:
+    /// the same values to rounding (see [`Carry`]). `planner` identifies the
+    /// planner whose `precomputed` pieces these are: a carry made by another
+    /// starts over.
+    pub fn carried(
+        precomputed: Precomputed<'a>,
+        now: Situation<'_>,
+        planner: u64,
+        carry: &mut Carry,
+    ) -> Self {
+        Self::build(precomputed, now, Some((planner, carry)))
+    }
+
+    fn build(
+        precomputed: Precomputed<'a>,
+        now: Situation<'_>,
+        carry: Option<(u64, &mut Carry)>,
+    ) -> Self {
+        let Precomputed { scenario, rays, .. } = precomputed;
+        let observed = now.observed;
         let classes: Vec<ClassRays> = rays
             .iter()
             .enumerate()
@@ -182,6 +196,22 @@ impl<'a> ExactEstimator<'a> {
                     })
             })
             .collect();
+        let carried = carry
+            .and_then(|(planner, carry)| carry.seen(planner, scenario, rays, &classes, observed));
+        let seen = match carried {
+            Some(seen) => seen,
+            None => Self::seen_sets(scenario, rays, &classes, observed),
+        };
+        Self::with_seen(precomputed, now, classes, seen)
+    }
+
+    /// Each class's seen set of `observed`.
+    fn seen_sets(
+        scenario: &Scenario,
+        rays: &[SourceRays],
+        classes: &[ClassRays],
+        observed: &[Vec<Look>],
+    ) -> Vec<RayHits> {
         // Each look's field of view as indexed by the rays, once for all
         // the classes.
         let keys: Vec<Vec<Option<LookKey>>> =
@@ -202,7 +232,7 @@ impl<'a> ExactEstimator<'a> {
         } else {
             Vec::new()
         };
-        let seen = classes
+        classes
             .par_iter()
             .with_min_len(crate::parallel::min_len())
             .map(|c| {
@@ -214,7 +244,29 @@ impl<'a> ExactEstimator<'a> {
                     hits
                 }
             })
-            .collect();
+            .collect()
+    }
+
+    /// The estimator of `now` with its classes' seen sets.
+    fn with_seen(
+        precomputed: Precomputed<'a>,
+        now: Situation<'_>,
+        classes: Vec<ClassRays>,
+        seen: Vec<RayHits>,
+    ) -> Self {
+        let Precomputed {
+            scenario,
+            stats,
+            rays,
+            grid,
+        } = precomputed;
+        let Situation {
+            targets,
+            starts,
+            types,
+            horizon,
+            ..
+        } = now;
 
         let grid = grid.filter(|_| scenario.all_square());
         let known: Vec<Target> = targets
@@ -293,6 +345,31 @@ impl<'a> ExactEstimator<'a> {
                 step.built[slot]
                     .get_or_init(|| self.seen_rays().window(grid, step.blocks[slot], t + 1));
             });
+    }
+
+    /// [`ExactEstimator::prepare`], the windows made from those `carry`
+    /// kept when it continues the last step (see [`Carry`]), and kept in
+    /// it for the next.
+    pub fn prepare_carried(&self, carry: &mut Carry) {
+        let Some(grid) = self.grid else { return };
+        let windows = match carry.take_windows(self.windows.len()) {
+            Some((old, change)) => {
+                self.seen_rays()
+                    .carried_windows(grid, &self.windows, old, &change)
+            }
+            None => None,
+        };
+        let windows = windows.or_else(|| self.seen_rays().whole_windows(grid, &self.windows));
+        let Some(windows) = windows else {
+            self.prepare();
+            return;
+        };
+        if !carry.is_empty() {
+            carry.keep_windows(windows.clone());
+        }
+        for (step, win) in self.windows.iter().zip(windows) {
+            let _ = step.built[0].set(win);
+        }
     }
 
     /// The window serving `sensor` at step `t`, if the fast path applies.

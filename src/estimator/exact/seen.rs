@@ -28,6 +28,7 @@ use crate::scenario::{Look, all_certain};
 /// merged with already reaches past the exit. An indexed look whose every
 /// interval starts past the exit is skipped whole
 /// ([`LookCrossings::past_exit`](super::rays::LookCrossings::past_exit)).
+#[derive(Clone, Default)]
 pub(super) struct RayHits {
     /// `hits[offsets[m]..offsets[m+1]]` are ray `m`'s intervals.
     pub(super) offsets: Vec<u32>,
@@ -287,6 +288,150 @@ impl RayHits {
             offsets,
             hits,
             detected: Vec::new(),
+            before: Vec::new(),
+        }
+    }
+
+    /// No intervals on as many rays as `like` has.
+    pub(super) fn empty(like: &RayHits) -> Self {
+        Self::empty_of(like.offsets.len().saturating_sub(1))
+    }
+
+    /// No intervals on `rays` rays.
+    pub(super) fn empty_of(rays: usize) -> Self {
+        RayHits {
+            offsets: vec![0; rays + 1],
+            ..Self::default()
+        }
+    }
+
+    /// Heap bytes held.
+    pub(super) fn memory_bytes(&self) -> usize {
+        self.offsets.capacity() * 4 + self.hits.capacity() * 16 + self.detected.capacity() * 8
+    }
+
+    /// The union of two unions of certain looks on the same rays, `a`'s
+    /// intervals pushed by `shift_a` and `b`'s by `shift_b`: per ray a merge
+    /// of two sorted lists, intervals that touch joined as
+    /// [`RayHits::new`] joins them.
+    pub(super) fn merged(a: &RayHits, shift_a: f64, b: &RayHits, shift_b: f64) -> Self {
+        let n = a.offsets.len() - 1;
+        debug_assert_eq!(n + 1, b.offsets.len());
+        debug_assert!(a.certain() && b.certain());
+        let mut offsets = Vec::with_capacity(n + 1);
+        offsets.push(0u32);
+        let mut hits: Vec<(f64, f64)> = Vec::with_capacity(a.hits.len() + b.hits.len());
+        for m in 0..n {
+            let (xa, xb) = (a.of(m), b.of(m));
+            let (mut i, mut j) = (0, 0);
+            let first = hits.len();
+            while i < xa.len() || j < xb.len() {
+                let take_a =
+                    j == xb.len() || (i < xa.len() && xa[i].0 + shift_a <= xb[j].0 + shift_b);
+                let (p, q) = if take_a {
+                    i += 1;
+                    (xa[i - 1].0 + shift_a, xa[i - 1].1 + shift_a)
+                } else {
+                    j += 1;
+                    (xb[j - 1].0 + shift_b, xb[j - 1].1 + shift_b)
+                };
+                match hits[first..].last_mut() {
+                    Some(last) if p <= last.1 => last.1 = last.1.max(q),
+                    _ => hits.push((p, q)),
+                }
+            }
+            offsets.push(hits.len() as u32);
+        }
+        RayHits {
+            offsets,
+            hits,
+            ..Self::default()
+        }
+    }
+
+    /// These intervals pushed by `shift`.
+    pub(super) fn lifted(mut self, shift: f64) -> Self {
+        if shift != 0.0 {
+            for h in &mut self.hits {
+                *h = (h.0 + shift, h.1 + shift);
+            }
+        }
+        self
+    }
+
+    /// These intervals without those that start past `beyond[m]` on ray
+    /// `m`: as [`RayHits::new`] leaves them out.
+    pub(super) fn within(mut self, beyond: &[f64]) -> Self {
+        let mut kept = 0;
+        let mut start = 0;
+        for (m, &far) in beyond.iter().enumerate() {
+            let end = self.offsets[m + 1] as usize;
+            for i in start..end {
+                if self.hits[i].0 <= far {
+                    self.hits[kept] = self.hits[i];
+                    kept += 1;
+                }
+            }
+            start = end;
+            self.offsets[m + 1] = kept as u32;
+        }
+        self.hits.truncate(kept);
+        self
+    }
+
+    /// What changed from `old` (pushed by `shift_old`) to `new`, two unions
+    /// of certain looks on the same rays: per ray the pieces of their
+    /// symmetric difference, sorted, each "detected" +1 where only `new`
+    /// holds it and −1 where only `old` does, so that a seen mass
+    /// accumulated over it is `new`'s less `old`'s.
+    pub(super) fn change(new: &RayHits, old: &RayHits, shift_old: f64) -> Self {
+        let n = new.offsets.len() - 1;
+        debug_assert_eq!(n + 1, old.offsets.len());
+        let mut offsets = Vec::with_capacity(n + 1);
+        offsets.push(0u32);
+        let mut hits: Vec<(f64, f64)> = Vec::new();
+        let mut detected: Vec<f64> = Vec::new();
+        let mut events: Vec<(f64, u8)> = Vec::new();
+        for m in 0..n {
+            events.clear();
+            // Bit 0: which set (1 = old); bit 1: an end.
+            events.extend(new.of(m).iter().flat_map(|&(p, q)| [(p, 0), (q, 2)]));
+            events.extend(
+                old.of(m)
+                    .iter()
+                    .flat_map(|&(p, q)| [(p + shift_old, 1), (q + shift_old, 3)]),
+            );
+            // At one distance starts first: a point interval opens, then
+            // closes.
+            events.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            let (mut in_new, mut in_old) = (false, false);
+            let mut prev = 0.0;
+            let first = hits.len();
+            for &(x, e) in &events {
+                if x > prev && in_new != in_old {
+                    let sign = if in_new { 1.0 } else { -1.0 };
+                    match (hits[first..].last_mut(), detected.last()) {
+                        (Some(last), Some(&d)) if last.1 == prev && d == sign => last.1 = x,
+                        _ => {
+                            hits.push((prev, x));
+                            detected.push(sign);
+                        }
+                    }
+                }
+                prev = x;
+                let opens = e & 2 == 0;
+                if e & 1 == 0 {
+                    in_new = opens;
+                } else {
+                    in_old = opens;
+                }
+            }
+            offsets.push(hits.len() as u32);
+        }
+        RayHits {
+            offsets,
+            hits,
+            detected,
             before: Vec::new(),
         }
     }

@@ -113,6 +113,7 @@ impl StepWindows {
 
 /// `u_t(E)` over a block of elementary rectangles: the expected targets in
 /// each at step `t` that no sensor can have seen.
+#[derive(Clone)]
 pub(super) struct Window {
     pub(super) a0: usize,
     pub(super) b0: usize,
@@ -122,6 +123,11 @@ pub(super) struct Window {
 }
 
 impl Window {
+    /// Heap bytes held.
+    pub(super) fn memory_bytes(&self) -> usize {
+        self.unseen.capacity() * std::mem::size_of::<f64>()
+    }
+
     /// The unseen mass of the window's row `b` (relative to its first).
     pub(super) fn row(&self, b: usize) -> &[f64] {
         &self.unseen[b * self.na..(b + 1) * self.na]
@@ -350,6 +356,56 @@ impl SeenRays<'_> {
             })
             .collect();
         Some(windows)
+    }
+
+    /// Every step's window over the whole grid from `carried`, the
+    /// windows of plan steps `1..=T` one session step earlier, and `change`,
+    /// per class, what the seen sets gained (+1) and lost (−1) since, as of
+    /// now (see [`carry`](super::carry)): the window of step `t < T` is the
+    /// carried one of step `t + 1` less the seen mass of the change, that of
+    /// step `T` is filled whole. `None` under the conditions of
+    /// [`SeenRays::whole_windows`].
+    pub(super) fn carried_windows(
+        &self,
+        grid: &ElementaryGrid,
+        windows: &[StepWindows],
+        mut carried: Vec<Window>,
+        change: &[RayHits],
+    ) -> Option<Vec<Window>> {
+        let (nx, ny) = grid.dims();
+        let whole = (0, nx, 0, ny);
+        let steps = windows.len();
+        if steps == 0
+            || carried.len() != steps
+            || change.len() != self.classes.len()
+            || !windows.iter().all(|w| w.blocks == [whole])
+            || !carried.iter().all(|w| (w.na, w.nb) == (nx, ny))
+            || self
+                .classes
+                .iter()
+                .any(|c| self.rays[c.rays].crossings.is_none())
+        {
+            return None;
+        }
+        let last = self.window(grid, whole, steps);
+        carried.remove(0);
+        if !carried.is_empty() {
+            let mut accs = vec![vec![0.0; nx * ny]; carried.len()];
+            for (class, change) in self.classes.iter().zip(change) {
+                let sr = &self.rays[class.rays];
+                let Some(cr) = &sr.crossings else { continue };
+                let lifts: Vec<f64> = (1..steps).map(|t| class.speed * t as f64).collect();
+                let mut views: Vec<&mut [f64]> = accs.iter_mut().map(Vec::as_mut_slice).collect();
+                accumulate_whole(sr, cr, class.weight, change, &lifts, &mut views);
+            }
+            for (win, acc) in carried.iter_mut().zip(&accs) {
+                for (u, s) in win.unseen.iter_mut().zip(acc) {
+                    *u -= s;
+                }
+            }
+        }
+        carried.push(last);
+        Some(carried)
     }
 
     /// Adds to `acc` what the rays of one class saw in each rectangle of
