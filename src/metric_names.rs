@@ -39,6 +39,13 @@ pub const CONNECTIONS_CLOSED_TOTAL: &str = "vigil_connections_closed_total";
 pub const SESSIONS_LIVE: &str = "vigil_sessions_live";
 /// Counter of sessions dropped, by `reason` (`idle`, `capacity`).
 pub const SESSIONS_EVICTED_TOTAL: &str = "vigil_sessions_evicted_total";
+/// Gauge of bytes of sessions' carries held (`--session-carry-mb`).
+pub const SESSION_CARRY_BYTES: &str = "vigil_session_carry_bytes";
+/// Counter of sessions' steps, by `carry`: `used` (the step continued its
+/// session's carry), `rebuilt` (it had none or another state's, and
+/// started over) or `none` (the carry does not apply: uncertain looks,
+/// buildings, the paper's estimator).
+pub const SESSION_STEPS_TOTAL: &str = "vigil_session_steps_total";
 
 /// Counter of registered scenarios' precomputations, by `outcome`
 /// (`loaded`: read from the database; `computed`: precomputed here under a
@@ -47,7 +54,7 @@ pub const SESSIONS_EVICTED_TOTAL: &str = "vigil_sessions_evicted_total";
 pub const PRECOMPUTED_TOTAL: &str = "vigil_precomputed_total";
 
 /// Every metric above.
-pub const ALL: [&str; 17] = [
+pub const ALL: [&str; 19] = [
     HTTP_REQUESTS_TOTAL,
     HTTP_REQUESTS_IN_FLIGHT,
     HTTP_SHED_TOTAL,
@@ -64,6 +71,8 @@ pub const ALL: [&str; 17] = [
     CONNECTIONS_CLOSED_TOTAL,
     SESSIONS_LIVE,
     SESSIONS_EVICTED_TOTAL,
+    SESSION_CARRY_BYTES,
+    SESSION_STEPS_TOTAL,
     PRECOMPUTED_TOTAL,
 ];
 

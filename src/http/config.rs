@@ -114,6 +114,12 @@ pub struct Config {
     /// sessions themselves are in the database).
     #[arg(long, env = "VIGIL_SESSION_CACHE_MB", default_value_t = (Settings::DEFAULT.session_cache_bytes >> 20) as u64)]
     pub session_cache_mb: u64,
+    /// Most megabytes of what sessions' steps keep for their next step
+    /// (each session's carry: seen sets and windows) on this replica; past
+    /// it the least recently used carry is dropped and its session's next
+    /// step starts over.
+    #[arg(long, env = "VIGIL_SESSION_CARRY_MB", default_value_t = (Settings::DEFAULT.session_carry_bytes >> 20) as u64)]
+    pub session_carry_mb: u64,
 }
 
 impl Config {
@@ -164,6 +170,8 @@ pub struct Settings {
     pub max_sessions: usize,
     /// With a database: most bytes of sessions cached by this replica.
     pub session_cache_bytes: usize,
+    /// Most bytes of sessions' carries held by this replica.
+    pub session_carry_bytes: usize,
     /// Whether plans predicted under [`INLINE_PLAN_MS`] run on the async
     /// worker that received them instead of on rayon's pool; `None`: when
     /// the pool has one thread (one core), where the hop to it and back is
@@ -215,6 +223,7 @@ impl Settings {
         session_ttl: Duration::from_secs(600),
         max_sessions: 10_000,
         session_cache_bytes: 256 << 20,
+        session_carry_bytes: 512 << 20,
         inline_plans: None,
     };
 }
@@ -245,6 +254,8 @@ impl From<&Config> for Settings {
             session_ttl: Duration::from_secs(c.session_ttl_s.max(1)),
             max_sessions: c.max_sessions.max(1),
             session_cache_bytes: usize::try_from(c.session_cache_mb.saturating_mul(1 << 20))
+                .unwrap_or(usize::MAX),
+            session_carry_bytes: usize::try_from(c.session_carry_mb.saturating_mul(1 << 20))
                 .unwrap_or(usize::MAX),
             inline_plans: None,
         }

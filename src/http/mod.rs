@@ -57,6 +57,7 @@ macro_rules! path_rules {
     };
 }
 
+pub mod carries;
 pub mod config;
 pub mod doc;
 pub mod error;

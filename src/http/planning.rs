@@ -15,6 +15,7 @@ use super::state::AppState;
 use crate::cancel::{CancelToken, Progress};
 use crate::catalog::{CatalogError, precompute_cancellable, predicted_precompute_ms};
 use crate::cost;
+use crate::estimator::Carry;
 use crate::metric_names;
 use crate::planner::{PlanInput, PlanRequest, PlanResponse, Planner};
 use crate::scenario::{Scenario, ScenarioSpec};
@@ -102,17 +103,52 @@ pub(super) async fn plan_admitted(
     planner: Arc<Planner>,
     req: &PlanRequest,
 ) -> Result<PlanResponse, ApiError> {
+    let (plan, _) = plan_admitted_with(state, start, planner, req, None).await?;
+    Ok(plan)
+}
+
+/// [`plan_admitted`] for a session's step, from and into the session's
+/// `carry` ([`Planner::plan_carried`]), which comes back with the plan (a
+/// step that fails drops it).
+pub(super) async fn plan_admitted_carried(
+    state: &AppState,
+    start: Option<Extension<RequestStart>>,
+    planner: Arc<Planner>,
+    req: &PlanRequest,
+    carry: Carry,
+) -> Result<(PlanResponse, Carry), ApiError> {
+    let (plan, carry) = plan_admitted_with(state, start, planner, req, Some(carry)).await?;
+    Ok((plan, carry.unwrap_or_default()))
+}
+
+async fn plan_admitted_with(
+    state: &AppState,
+    start: Option<Extension<RequestStart>>,
+    planner: Arc<Planner>,
+    req: &PlanRequest,
+    carry: Option<Carry>,
+) -> Result<(PlanResponse, Option<Carry>), ApiError> {
     let input = PlanInput::new(&planner.scenario, req)?;
     let predicted_ms = cost::plan_ms(&planner, &input);
     refuse_if_costly(state, predicted_ms)?;
     let guard = CancelOnDrop::new("plan", start, state);
     let token = guard.token();
-    let res = if state.settings.plans_inline() && predicted_ms <= INLINE_PLAN_MS {
+    let inline = state.settings.plans_inline() && predicted_ms <= INLINE_PLAN_MS;
+    let work = move || match carry {
+        Some(mut carry) => planner
+            .plan_carried(&input, &token, &mut carry)
+            .map(|plan| (plan, Some(carry))),
+        None if inline => planner.plan_here(&input, &token).map(|plan| (plan, None)),
+        None => planner
+            .plan_cancellable(&input, &token)
+            .map(|plan| (plan, None)),
+    };
+    let res = if inline {
         metrics::counter!(metric_names::PLANS_TOTAL, "on" => "worker").increment(1);
-        super::queue::on_this_worker(|| planner.plan_here(&input, &token)).await
+        super::queue::on_this_worker(work).await
     } else {
         metrics::counter!(metric_names::PLANS_TOTAL, "on" => "pool").increment(1);
-        super::queue::on_rayon(move || planner.plan_cancellable(&input, &token)).await
+        super::queue::on_rayon(work).await
     };
     guard.finish();
     // A cancelled plan that is still awaited was cancelled by its deadline.

@@ -22,12 +22,13 @@ use super::doc::{self, examples};
 use super::error::ApiError;
 use super::extract::{Json, Path, QueuedJson};
 use super::middleware::RequestStart;
-use super::planning::{plan_admitted, resolve_scenario};
+use super::planning::{plan_admitted_carried, resolve_scenario};
 use super::session_store::Refreshed;
 use super::state::AppState;
 use crate::catalog::predicted_precompute_ms;
 use crate::fit::SourceRate;
 use crate::limits::{MAX_HORIZON, MAX_IDEMPOTENCY_KEY_CHARS, MAX_MIN_SEPARATION, MAX_TARGETS};
+use crate::metric_names;
 use crate::planner::{PlanResponse, Planner, check_estimator};
 use crate::scenario::{ScenarioSpec, ValidationError};
 use crate::session::{Session, SessionSettings, StepRequest, Track};
@@ -243,7 +244,7 @@ pub async fn step(
             Refreshed::Replay(answer) => return Ok(json_bytes(answer)),
             Refreshed::Session(session) => session,
         };
-        let answer = match make_step(&state, start, session, &req).await {
+        let answer = match make_step(&state, start, &id, session, &req).await {
             Ok(answer) => answer,
             Err(e) => {
                 state.sessions.touch(&id);
@@ -286,6 +287,7 @@ fn idempotency_key(headers: &HeaderMap) -> Result<Option<&str>, ApiError> {
 async fn make_step(
     state: &AppState,
     start: Option<Extension<RequestStart>>,
+    id: &str,
     session: &mut Session,
     req: &StepRequest,
 ) -> Result<Bytes, ApiError> {
@@ -311,7 +313,12 @@ async fn make_step(
         None => None,
     };
     let planner = session.planner_for(learnt.as_ref());
-    let plan = plan_admitted(state, start, planner, &prepared.request).await?;
+    let carry = state.carries.take(id);
+    let (plan, carry) =
+        plan_admitted_carried(state, start, planner, &prepared.request, carry).await?;
+    metrics::counter!(metric_names::SESSION_STEPS_TOTAL, "carry" => carry.last_use().as_str())
+        .increment(1);
+    state.carries.keep(id, carry);
     let step = session.step();
     let rates = learnt.as_ref().map(|learnt| learnt.rates().to_vec());
     let answer = serde_json::to_vec(&StepResponse { step, plan, rates })
@@ -417,5 +424,6 @@ pub async fn delete(
     Path(id): Path<String>,
 ) -> Result<StatusCode, ApiError> {
     state.sessions.remove(&id).await?;
+    state.carries.forget(&id);
     Ok(StatusCode::NO_CONTENT)
 }

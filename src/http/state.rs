@@ -3,6 +3,7 @@
 
 use std::sync::Arc;
 
+use super::carries::Carries;
 use super::config::{Config, Settings};
 use super::session_store::SessionStore;
 use crate::catalog::{PlannerCache, Registry};
@@ -17,6 +18,8 @@ pub struct AppState {
     pub cache: Arc<PlannerCache>,
     /// Step-by-step clients' sessions.
     pub sessions: Arc<SessionStore>,
+    /// What the sessions' steps kept for their next steps, on this replica.
+    pub carries: Arc<Carries>,
     /// Limits, keys and CORS.
     pub settings: Arc<Settings>,
 }
@@ -45,6 +48,7 @@ impl AppState {
                 settings.session_ttl,
                 settings.max_sessions,
             )),
+            carries: Arc::new(Carries::new(settings.session_carry_bytes)),
             settings: Arc::new(settings),
         }
     }

@@ -1,0 +1,117 @@
+//! Each replica's sessions' carries ([`Carry`]): what a step kept for its
+//! session's next step, held by session id under a byte budget
+//! (`--session-carry-mb`), the least recently used dropped first.
+//!
+//! A carry is a cache: it is checked against the step's state before use
+//! (see [`Carry`]), so one that another replica's steps made stale, or that
+//! was dropped, costs a step that starts over, never a different plan. It
+//! is not stored in the database; a step on another replica builds its own.
+
+use std::collections::{BTreeMap, HashMap};
+use std::sync::{Mutex, PoisonError};
+
+use crate::estimator::Carry;
+use crate::metric_names;
+
+/// The carries of this replica's sessions.
+#[derive(Debug)]
+pub struct Carries {
+    limit: usize,
+    held: Mutex<Held>,
+}
+
+#[derive(Debug, Default)]
+struct Held {
+    bytes: usize,
+    tick: u64,
+    /// By session id: when it was last kept, its carry and its bytes.
+    by_id: HashMap<String, Kept>,
+    /// Session ids by when they were last kept, oldest first.
+    order: BTreeMap<u64, String>,
+}
+
+struct Kept {
+    tick: u64,
+    carry: Carry,
+    bytes: usize,
+}
+
+impl std::fmt::Debug for Kept {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Kept")
+            .field("tick", &self.tick)
+            .field("bytes", &self.bytes)
+            .finish()
+    }
+}
+
+impl Carries {
+    /// No carries, at most `limit` bytes of them (0: none kept).
+    pub fn new(limit: usize) -> Self {
+        Self {
+            limit,
+            held: Mutex::new(Held::default()),
+        }
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, Held> {
+        // Every update leaves the maps consistent: a panic elsewhere
+        // poisons nothing that matters.
+        self.held.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    /// Session `id`'s carry, taken out (an empty one if none is held).
+    pub fn take(&self, id: &str) -> Carry {
+        let mut held = self.lock();
+        let Some(kept) = held.by_id.remove(id) else {
+            return Carry::new();
+        };
+        held.order.remove(&kept.tick);
+        held.bytes -= kept.bytes;
+        Self::report(&held);
+        kept.carry
+    }
+
+    /// Keeps `carry` for session `id`'s next step, dropping the least
+    /// recently kept carries past the budget (an empty carry, or one larger
+    /// than the whole budget, is not kept).
+    pub fn keep(&self, id: &str, carry: Carry) {
+        let bytes = carry.memory_bytes();
+        let mut held = self.lock();
+        if let Some(old) = held.by_id.remove(id) {
+            held.order.remove(&old.tick);
+            held.bytes -= old.bytes;
+        }
+        if !carry.is_empty() && bytes <= self.limit {
+            while held.bytes + bytes > self.limit {
+                let Some((_, oldest)) = held.order.pop_first() else {
+                    break;
+                };
+                if let Some(dropped) = held.by_id.remove(&oldest) {
+                    held.bytes -= dropped.bytes;
+                }
+            }
+            held.tick += 1;
+            let tick = held.tick;
+            held.order.insert(tick, id.to_string());
+            held.by_id
+                .insert(id.to_string(), Kept { tick, carry, bytes });
+            held.bytes += bytes;
+        }
+        Self::report(&held);
+    }
+
+    /// Drops session `id`'s carry (the session ended).
+    pub fn forget(&self, id: &str) {
+        drop(self.take(id));
+    }
+
+    /// Bytes held now.
+    pub fn bytes(&self) -> usize {
+        self.lock().bytes
+    }
+
+    fn report(held: &Held) {
+        metrics::gauge!(metric_names::SESSION_CARRY_BYTES).set(held.bytes as f64);
+    }
+}
