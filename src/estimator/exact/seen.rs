@@ -391,23 +391,43 @@ impl RayHits {
         offsets.push(0u32);
         let mut hits: Vec<(f64, f64)> = Vec::new();
         let mut detected: Vec<f64> = Vec::new();
-        let mut events: Vec<(f64, u8)> = Vec::new();
         for m in 0..n {
-            events.clear();
-            // Bit 0: which set (1 = old); bit 1: an end.
-            events.extend(new.of(m).iter().flat_map(|&(p, q)| [(p, 0), (q, 2)]));
-            events.extend(
-                old.of(m)
-                    .iter()
-                    .flat_map(|&(p, q)| [(p + shift_old, 1), (q + shift_old, 3)]),
-            );
-            // At one distance starts first: a point interval opens, then
-            // closes.
-            events.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            let (a, b) = (new.of(m), old.of(m));
+            // Each union's boundaries in order (its intervals are disjoint
+            // and do not touch), merged: bit 0 of an event says which set
+            // (1 = old), bit 1 an end; at one distance starts first, so a
+            // point interval opens, then closes.
+            let bound = |xs: &[(f64, f64)], i: usize, shift: f64, set: u8| {
+                let (p, q) = xs[i / 2];
+                if i.is_multiple_of(2) {
+                    (p + shift, set)
+                } else {
+                    (q + shift, set | 2)
+                }
+            };
+            let (na, nb) = (2 * a.len(), 2 * b.len());
+            let (mut i, mut j) = (0, 0);
+            let events = std::iter::from_fn(|| {
+                let ea = (i < na).then(|| bound(a, i, 0.0, 0));
+                let eb = (j < nb).then(|| bound(b, j, shift_old, 1));
+                let take_a = match (ea, eb) {
+                    (Some(x), Some(y)) => x.0 < y.0 || (x.0 == y.0 && x.1 <= y.1),
+                    (Some(_), None) => true,
+                    (None, Some(_)) => false,
+                    (None, None) => return None,
+                };
+                if take_a {
+                    i += 1;
+                    ea
+                } else {
+                    j += 1;
+                    eb
+                }
+            });
             let (mut in_new, mut in_old) = (false, false);
             let mut prev = 0.0;
             let first = hits.len();
-            for &(x, e) in &events {
+            for (x, e) in events {
                 if x > prev && in_new != in_old {
                     let sign = if in_new { 1.0 } else { -1.0 };
                     match (hits[first..].last_mut(), detected.last()) {
