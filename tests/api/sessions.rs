@@ -7,6 +7,7 @@ use std::time::Duration;
 use reqwest::{StatusCode, header};
 use serde_json::{Value, json};
 use vigil::http::config::Settings;
+use vigil::limits::MAX_HISTORY_STEPS;
 
 use crate::helpers::{
     TestApp, assert_problem, assert_validation, json_body, metric, spawn_app, spawn_with,
@@ -57,7 +58,7 @@ async fn a_session_records_steps_and_plans_as_the_stateless_request() {
             "targets": [{"id": 17, "x": 60.0, "y": 40.0, "vx": 10.0, "vy": 0.0}]}))
         .await;
     let stateless = json_body(stateless, StatusCode::OK).await;
-    assert_eq!(step0["plans"], stateless["plans"]);
+    assert_same_plans(&step0, &stateless);
 
     // Step 1: nothing detected; the track moved on, the history holds step 0.
     let second = json!({"sensors": sensors(10.0)});
@@ -72,11 +73,7 @@ async fn a_session_records_steps_and_plans_as_the_stateless_request() {
             "history": [[{"x": 55.0, "y": 55.0}, {"x": 245.0, "y": 60.0}]]}))
         .await;
     let stateless = json_body(stateless, StatusCode::OK).await;
-    assert_eq!(step1["plans"], stateless["plans"]);
-    assert_eq!(
-        step1["expected_detections"],
-        stateless["expected_detections"]
-    );
+    assert_same_plans(&step1, &stateless);
 
     let info = json_body(app.get(&format!("/v1/sessions/{id}")).await, StatusCode::OK).await;
     assert_eq!(info["step"], 2);
@@ -130,7 +127,7 @@ async fn a_session_takes_an_inline_scenario_and_refuses_bad_settings() {
     let res = app
         .post_json(
             "/v1/sessions",
-            &json!({"scenario_id": "paper-v10", "history_steps": 40}),
+            &json!({"scenario_id": "paper-v10", "history_steps": MAX_HISTORY_STEPS + 1}),
         )
         .await;
     assert_validation(res, "history_steps").await;
@@ -244,4 +241,32 @@ async fn a_step_retried_with_its_idempotency_key_is_answered_not_made_again() {
     // A key over 128 characters is refused.
     let res = step(&"k".repeat(129), 0.0).await.unwrap();
     assert_problem(res, StatusCode::BAD_REQUEST, "Idempotency-Key").await;
+}
+
+/// A session step's plans are the stateless plan's: the same paths, and
+/// the same values to 1e-9 (a step carried from the last one rounds
+/// differently).
+fn assert_same_plans(step: &Value, stateless: &Value) {
+    let close = |a: &Value, b: &Value| {
+        let (a, b) = (a.as_f64().unwrap(), b.as_f64().unwrap());
+        (a - b).abs() <= 1e-9 * a.abs().max(1.0)
+    };
+    assert!(close(
+        &step["expected_detections"],
+        &stateless["expected_detections"]
+    ));
+    let (a, b) = (
+        step["plans"].as_array().unwrap(),
+        stateless["plans"].as_array().unwrap(),
+    );
+    assert_eq!(a.len(), b.len());
+    for (a, b) in a.iter().zip(b) {
+        assert_eq!(a["sensor"], b["sensor"]);
+        assert_eq!(a["path"], b["path"]);
+        assert_eq!(a["priority"], b["priority"]);
+        assert!(
+            close(&a["expected_detections"], &b["expected_detections"]),
+            "{a} against {b}"
+        );
+    }
 }

@@ -35,6 +35,28 @@ fn answer(mut v: Value) -> Value {
     v
 }
 
+/// Two answers alike but for rounding: every number to 1e-9 (relative
+/// past 1), everything else equal. A replica that carried the session's
+/// derived state from its last step (its carry) plans the stateless plan to
+/// that precision, not to the bit.
+fn same_answer(a: &Value, b: &Value) -> bool {
+    match (a, b) {
+        (Value::Number(x), Value::Number(y)) => match (x.as_f64(), y.as_f64()) {
+            (Some(x), Some(y)) => (x - y).abs() <= 1e-9 * x.abs().max(y.abs()).max(1.0),
+            _ => x == y,
+        },
+        (Value::Array(x), Value::Array(y)) => {
+            x.len() == y.len() && x.iter().zip(y).all(|(x, y)| same_answer(x, y))
+        }
+        (Value::Object(x), Value::Object(y)) => {
+            x.len() == y.len()
+                && x.iter()
+                    .all(|(k, v)| y.get(k).is_some_and(|w| same_answer(v, w)))
+        }
+        _ => a == b,
+    }
+}
+
 async fn open(server: &Server, body_json: &Value) -> String {
     let (status, info) = body(server.post("/v1/sessions", body_json).await).await;
     assert_eq!(status, StatusCode::CREATED, "{info}");
@@ -79,7 +101,11 @@ pub async fn sessions_across_replicas(cluster: Arc<Cluster>) {
         } else {
             &a
         };
-        assert_eq!(step(server, &shared, k).await, expected, "step {k}");
+        let got = step(server, &shared, k).await;
+        assert!(
+            same_answer(&got, &expected),
+            "step {k}: {got} against {expected}"
+        );
     }
     for server in [&a, &b] {
         let (status, info) = body(server.get(&format!("/v1/sessions/{shared}")).await).await;
