@@ -72,7 +72,7 @@ pub const MAX_SENSORS: usize = 256;
 /// Most targets in one request.
 pub const MAX_TARGETS: usize = 20_000;
 /// Most steps of history.
-pub const MAX_HISTORY_STEPS: usize = 32;
+pub const MAX_HISTORY_STEPS: usize = 128;
 
 /// Most characters of a session step's `Idempotency-Key` header.
 pub const MAX_IDEMPOTENCY_KEY_CHARS: usize = 128;

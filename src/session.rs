@@ -91,7 +91,7 @@ pub struct SessionSettings {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(value_type = Option<u32>, minimum = 0)]
     pub min_separation: Option<Integer>,
-    /// Steps of history kept (0..=32, 16 by default): the sensors' past
+    /// Steps of history kept (0..=128, 16 by default): the sensors' past
     /// positions planned with, and how long a track lives undetected.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(value_type = Option<u32>, minimum = 0)]

@@ -86,7 +86,7 @@ struct Args {
     #[arg(long)]
     horizon: Option<usize>,
     /// Steps of history (sensor positions and tracks) reported to the planner.
-    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u8).range(0..=32))]
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u8).range(0..=vigil::limits::MAX_HISTORY_STEPS as i64))]
     history: u8,
     /// Where the sensors start.
     #[arg(long, value_enum, default_value_t = Start::Grid)]

@@ -100,7 +100,7 @@ pub struct StepResponse {
         sensors' past positions and the targets' tracks, so each step sends only the sensors \
         now and the targets detected now. The body names the scenario (`scenario_id`, or an \
         inline `scenario` as in `POST /v1/plan`) and the defaults of its steps; \
-        `history_steps` (0..=32, 16 by default) is how many steps of history it keeps. \
+        `history_steps` (0..=128, 16 by default) is how many steps of history it keeps. \
         Without a database a session lives in the memory of the replica that created it: \
         route its requests there. With `--database-url` it is kept in the database, and every \
         replica on it serves it. A session idle for `--session-ttl-s` (600 s), or the least \

@@ -3,6 +3,7 @@
 
 use reqwest::{StatusCode, header};
 use serde_json::{Value, json};
+use vigil::limits::MAX_HISTORY_STEPS;
 
 use crate::helpers::{
     TestApp, assert_problem, assert_validation, plan_request, small_spec, spawn_app,
@@ -325,7 +326,7 @@ async fn invalid_plan_requests_are_422() {
     .await;
     plan_rejected(
         &app,
-        |r| r["history"] = json!(vec![positions(3); 33]),
+        |r| r["history"] = json!(vec![positions(3); MAX_HISTORY_STEPS + 1]),
         "history",
     )
     .await;

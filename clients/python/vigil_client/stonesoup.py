@@ -863,7 +863,7 @@ class VigilSensorManager(SensorManager):
     time_step: datetime.timedelta = Property(
         default=datetime.timedelta(seconds=1), doc="Stone Soup time of one Vigil step."
     )
-    history_steps: int = Property(default=16, doc="Steps of looks (and track age) kept, 0..32.")
+    history_steps: int = Property(default=16, doc="Steps of looks (and track age) kept, 0..128.")
     plan_options: Mapping[str, Any] = Property(
         default=None,
         doc="Extra plan request fields: horizon, estimator, objective, coordination, "
@@ -902,8 +902,8 @@ class VigilSensorManager(SensorManager):
                 self.map.sensor_type(name)
             except KeyError as e:
                 raise ValueError(f"sensor_types[{pid!r}]: {e.args[0]}") from None
-        if not 0 <= self.history_steps <= 32:
-            raise ValueError(f"history_steps must be in 0..=32, got {self.history_steps}")
+        if not 0 <= self.history_steps <= 128:
+            raise ValueError(f"history_steps must be in 0..=128, got {self.history_steps}")
         if self.learn_rates and not self.use_session:
             raise ValueError("learn_rates needs use_session=True: a session keeps what it learns")
         self._looks: deque[tuple[datetime.datetime, list[dict]]] = deque()

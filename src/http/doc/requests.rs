@@ -162,7 +162,7 @@ macro_rules! session_request_with {
             /// scenario's by default.
             #[schema(value_type = Option<u32>, minimum = 0)]
             pub min_separation: Option<Integer>,
-            /// Steps of history kept (0..=32, 16 by default): the sensors'
+            /// Steps of history kept (0..=128, 16 by default): the sensors'
             /// past positions planned with, and how long a track lives
             /// undetected.
             #[schema(value_type = Option<u32>, minimum = 0)]

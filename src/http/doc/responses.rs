@@ -115,7 +115,7 @@ pub struct SessionConflict(pub Problem);
     content_type = "application/problem+json",
     examples(
         ("history-steps" = (summary = "Too much history", value = json!(invalid(
-            "history_steps", "must be an integer in 0..=32, got 40"
+            "history_steps", "must be an integer in 0..=128, got 200"
         )))),
         ("one-of" = (summary = "Neither scenario_id nor scenario", value = json!(problem(
             ApiError::Unprocessable("exactly one of `scenario_id` and `scenario` is required".to_owned())

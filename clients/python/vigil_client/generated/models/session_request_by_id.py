@@ -24,7 +24,7 @@ class SessionRequestById:
         scenario_id (str): Id of a registered scenario, or of one sent inline before. Example: paper-v10.
         coordination (Coordination | None | Unset):
         estimator (EstimatorKind | None | Unset):
-        history_steps (int | None | Unset): Steps of history kept (0..=32, 16 by default): the sensors'
+        history_steps (int | None | Unset): Steps of history kept (0..=128, 16 by default): the sensors'
             past positions planned with, and how long a track lives
             undetected.
         horizon (int | None | Unset): Horizon T of its steps; the scenario's by default.

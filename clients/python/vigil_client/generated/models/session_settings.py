@@ -30,7 +30,7 @@ class SessionSettings:
                 `certify`).
             coordination (Coordination | None | Unset):
             estimator (EstimatorKind | None | Unset):
-            history_steps (int | None | Unset): Steps of history kept (0..=32, 16 by default): the sensors' past
+            history_steps (int | None | Unset): Steps of history kept (0..=128, 16 by default): the sensors' past
                 positions planned with, and how long a track lives undetected.
             horizon (int | None | Unset): Horizon T; the scenario's by default.
             learn_rates (bool | None | Unset): Learn the sources' rates from the detections (false by default):

@@ -105,13 +105,13 @@ def sync_detailed(
      Opens a session for a client that plans every step: the server keeps the sensors' past positions and
     the targets' tracks, so each step sends only the sensors now and the targets detected now. The body
     names the scenario (`scenario_id`, or an inline `scenario` as in `POST /v1/plan`) and the defaults
-    of its steps; `history_steps` (0..=32, 16 by default) is how many steps of history it keeps. Without
-    a database a session lives in the memory of the replica that created it: route its requests there.
-    With `--database-url` it is kept in the database, and every replica on it serves it. A session idle
-    for `--session-ttl-s` (600 s), or the least recently used past `--max-sessions` (10 000), is
-    dropped. With `learn_rates: true` the session learns the sources' rates from its detections (each
-    needs an `id`), plans with them and reports them as `rates` at every step (see `docs/learning.md`);
-    only a scenario precomputed within `--sync-precompute-ms` may learn.
+    of its steps; `history_steps` (0..=128, 16 by default) is how many steps of history it keeps.
+    Without a database a session lives in the memory of the replica that created it: route its requests
+    there. With `--database-url` it is kept in the database, and every replica on it serves it. A
+    session idle for `--session-ttl-s` (600 s), or the least recently used past `--max-sessions` (10
+    000), is dropped. With `learn_rates: true` the session learns the sources' rates from its detections
+    (each needs an `id`), plans with them and reports them as `rates` at every step (see
+    `docs/learning.md`); only a scenario precomputed within `--sync-precompute-ms` may learn.
 
     Args:
         body (SessionRequestById | SessionRequestWithScenario): Body of `POST /v1/sessions`:
@@ -147,13 +147,13 @@ def sync(
      Opens a session for a client that plans every step: the server keeps the sensors' past positions and
     the targets' tracks, so each step sends only the sensors now and the targets detected now. The body
     names the scenario (`scenario_id`, or an inline `scenario` as in `POST /v1/plan`) and the defaults
-    of its steps; `history_steps` (0..=32, 16 by default) is how many steps of history it keeps. Without
-    a database a session lives in the memory of the replica that created it: route its requests there.
-    With `--database-url` it is kept in the database, and every replica on it serves it. A session idle
-    for `--session-ttl-s` (600 s), or the least recently used past `--max-sessions` (10 000), is
-    dropped. With `learn_rates: true` the session learns the sources' rates from its detections (each
-    needs an `id`), plans with them and reports them as `rates` at every step (see `docs/learning.md`);
-    only a scenario precomputed within `--sync-precompute-ms` may learn.
+    of its steps; `history_steps` (0..=128, 16 by default) is how many steps of history it keeps.
+    Without a database a session lives in the memory of the replica that created it: route its requests
+    there. With `--database-url` it is kept in the database, and every replica on it serves it. A
+    session idle for `--session-ttl-s` (600 s), or the least recently used past `--max-sessions` (10
+    000), is dropped. With `learn_rates: true` the session learns the sources' rates from its detections
+    (each needs an `id`), plans with them and reports them as `rates` at every step (see
+    `docs/learning.md`); only a scenario precomputed within `--sync-precompute-ms` may learn.
 
     Args:
         body (SessionRequestById | SessionRequestWithScenario): Body of `POST /v1/sessions`:
@@ -184,13 +184,13 @@ async def asyncio_detailed(
      Opens a session for a client that plans every step: the server keeps the sensors' past positions and
     the targets' tracks, so each step sends only the sensors now and the targets detected now. The body
     names the scenario (`scenario_id`, or an inline `scenario` as in `POST /v1/plan`) and the defaults
-    of its steps; `history_steps` (0..=32, 16 by default) is how many steps of history it keeps. Without
-    a database a session lives in the memory of the replica that created it: route its requests there.
-    With `--database-url` it is kept in the database, and every replica on it serves it. A session idle
-    for `--session-ttl-s` (600 s), or the least recently used past `--max-sessions` (10 000), is
-    dropped. With `learn_rates: true` the session learns the sources' rates from its detections (each
-    needs an `id`), plans with them and reports them as `rates` at every step (see `docs/learning.md`);
-    only a scenario precomputed within `--sync-precompute-ms` may learn.
+    of its steps; `history_steps` (0..=128, 16 by default) is how many steps of history it keeps.
+    Without a database a session lives in the memory of the replica that created it: route its requests
+    there. With `--database-url` it is kept in the database, and every replica on it serves it. A
+    session idle for `--session-ttl-s` (600 s), or the least recently used past `--max-sessions` (10
+    000), is dropped. With `learn_rates: true` the session learns the sources' rates from its detections
+    (each needs an `id`), plans with them and reports them as `rates` at every step (see
+    `docs/learning.md`); only a scenario precomputed within `--sync-precompute-ms` may learn.
 
     Args:
         body (SessionRequestById | SessionRequestWithScenario): Body of `POST /v1/sessions`:
@@ -224,13 +224,13 @@ async def asyncio(
      Opens a session for a client that plans every step: the server keeps the sensors' past positions and
     the targets' tracks, so each step sends only the sensors now and the targets detected now. The body
     names the scenario (`scenario_id`, or an inline `scenario` as in `POST /v1/plan`) and the defaults
-    of its steps; `history_steps` (0..=32, 16 by default) is how many steps of history it keeps. Without
-    a database a session lives in the memory of the replica that created it: route its requests there.
-    With `--database-url` it is kept in the database, and every replica on it serves it. A session idle
-    for `--session-ttl-s` (600 s), or the least recently used past `--max-sessions` (10 000), is
-    dropped. With `learn_rates: true` the session learns the sources' rates from its detections (each
-    needs an `id`), plans with them and reports them as `rates` at every step (see `docs/learning.md`);
-    only a scenario precomputed within `--sync-precompute-ms` may learn.
+    of its steps; `history_steps` (0..=128, 16 by default) is how many steps of history it keeps.
+    Without a database a session lives in the memory of the replica that created it: route its requests
+    there. With `--database-url` it is kept in the database, and every replica on it serves it. A
+    session idle for `--session-ttl-s` (600 s), or the least recently used past `--max-sessions` (10
+    000), is dropped. With `learn_rates: true` the session learns the sources' rates from its detections
+    (each needs an `id`), plans with them and reports them as `rates` at every step (see
+    `docs/learning.md`); only a scenario precomputed within `--sync-precompute-ms` may learn.
 
     Args:
         body (SessionRequestById | SessionRequestWithScenario): Body of `POST /v1/sessions`:
