@@ -106,8 +106,6 @@ struct ClassCarry {
     /// The union of the other, newer held steps, in the base (`None`:
     /// none).
     back: Option<RayHits>,
-    /// The seen set at the newest step, as the estimator reads it.
-    seen: RayHits,
 }
 
 impl Carry {
@@ -132,7 +130,6 @@ impl Carry {
             .map(|c| {
                 c.front.iter().map(RayHits::memory_bytes).sum::<usize>()
                     + c.back.as_ref().map_or(0, RayHits::memory_bytes)
-                    + c.seen.memory_bytes()
                     + c.union.memory_bytes()
             })
             .sum();
@@ -201,7 +198,7 @@ impl Carry {
             self.rebuild(planner, scenario, rays, classes, observed);
             self.last = CarryUse::Rebuilt;
         }
-        Some(self.classes.iter().map(|c| c.seen.clone()).collect())
+        Some(self.seen_now(rays))
     }
 
     /// Adds the step of `looks` as the newest, lets the oldest go so that
@@ -217,7 +214,7 @@ impl Carry {
             let shift = c.speed * (base - now) as f64;
             c.back = Some(match c.back.take() {
                 Some(back) => RayHits::merged(&back, 0.0, raw, shift),
-                None => RayHits::merged(raw, shift, &RayHits::empty(raw), 0.0),
+                None => raw.clone().lifted(shift),
             });
         }
         while self.steps.len() > held {
@@ -229,7 +226,7 @@ impl Carry {
                 c.front.pop_front();
             }
         }
-        self.refresh_seen(rays);
+        self.join(rays);
     }
 
     /// Moves every held step to the front, its suffix unions rebuilt in
@@ -247,7 +244,7 @@ impl Carry {
                 let shift = c.speed * (n - 1 - i) as f64;
                 let union = match &suffix {
                     Some(s) => RayHits::merged(raw, shift, s, 0.0),
-                    None => RayHits::merged(raw, shift, &RayHits::empty(raw), 0.0),
+                    None => raw.clone().lifted(shift),
                 };
                 c.front.push_front(union.clone());
                 suffix = Some(union);
@@ -281,18 +278,14 @@ impl Carry {
                 front: VecDeque::new(),
                 union: RayHits::default(),
                 back: None,
-                seen: RayHits::empty_of(rays[c.rays].dirs.len()),
             })
             .collect();
         self.flip();
-        self.refresh_seen(rays);
+        self.join(rays);
     }
 
-    /// Each class's seen set at the newest step: its front's and back's
-    /// unions, brought from the base to now, without what starts past a
-    /// ray's exit.
-    fn refresh_seen(&mut self, rays: &[SourceRays]) {
-        let lift_steps = (self.now - self.base) as f64;
+    /// Each class's union of every held step: its front's and back's.
+    fn join(&mut self, rays: &[SourceRays]) {
         for c in &mut self.classes {
             c.union = match (c.front.front(), &c.back) {
                 (Some(f), Some(b)) => RayHits::merged(f, 0.0, b, 0.0),
@@ -300,9 +293,22 @@ impl Carry {
                 (None, Some(b)) => b.clone(),
                 (None, None) => RayHits::empty_of(rays[c.rays].dirs.len()),
             };
-            let lift = c.speed * lift_steps;
-            c.seen = c.union.clone().lifted(lift).within(&rays[c.rays].beyond);
         }
+    }
+
+    /// Each class's seen set at the newest step: its union brought from
+    /// the base to now, without what starts past a ray's exit.
+    fn seen_now(&self, rays: &[SourceRays]) -> Vec<RayHits> {
+        let lift_steps = (self.now - self.base) as f64;
+        self.classes
+            .iter()
+            .map(|c| {
+                c.union
+                    .clone()
+                    .lifted(c.speed * lift_steps)
+                    .within(&rays[c.rays].beyond)
+            })
+            .collect()
     }
 
     /// The windows carried for `horizon` plan steps and, per class, what

@@ -292,11 +292,6 @@ impl RayHits {
         }
     }
 
-    /// No intervals on as many rays as `like` has.
-    pub(super) fn empty(like: &RayHits) -> Self {
-        Self::empty_of(like.offsets.len().saturating_sub(1))
-    }
-
     /// No intervals on `rays` rays.
     pub(super) fn empty_of(rays: usize) -> Self {
         RayHits {
