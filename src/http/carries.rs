@@ -115,3 +115,57 @@ impl Carries {
         metrics::gauge!(metric_names::SESSION_CARRY_BYTES).set(held.bytes as f64);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cancel::CancelToken;
+    use crate::planner::{PlanInput, PlanRequest, Planner};
+    use crate::scenario::builtins;
+
+    /// The carry of a plan on `paper-v10` with one step of history, the
+    /// sensor at `x`.
+    fn carry(planner: &Planner, x: f64) -> Carry {
+        let req: PlanRequest = serde_json::from_value(serde_json::json!({
+            "sensors": [{"id": "a", "x": x, "y": 150.0}],
+            "history": [[{"x": x, "y": 140.0}]],
+        }))
+        .expect("a plan request");
+        let input = PlanInput::new(&planner.scenario, &req).expect("valid");
+        let mut carry = Carry::new();
+        planner
+            .plan_carried(&input, &CancelToken::never(), &mut carry)
+            .expect("never cancelled");
+        assert!(!carry.is_empty());
+        carry
+    }
+
+    #[test]
+    fn the_least_recently_kept_carry_goes_first_past_the_budget() {
+        let planner = Planner::new(builtins().remove(0));
+        let one = carry(&planner, 150.0).memory_bytes();
+        // Room for two carries of about this size, not three.
+        let carries = Carries::new(2 * one + one / 2);
+        carries.keep("a", carry(&planner, 150.0));
+        carries.keep("b", carry(&planner, 160.0));
+        assert!(carries.bytes() > one);
+        // Taking "a" and keeping it again makes "b" the oldest.
+        let a = carries.take("a");
+        assert!(!a.is_empty());
+        carries.keep("a", a);
+        carries.keep("c", carry(&planner, 170.0));
+        assert!(
+            carries.take("b").is_empty(),
+            "b was the least recently kept"
+        );
+        assert!(!carries.take("c").is_empty());
+        assert!(carries.bytes() <= 2 * one + one / 2);
+        carries.forget("a");
+        assert_eq!(carries.bytes(), 0);
+        // Nothing is kept past a budget smaller than one carry.
+        let none = Carries::new(one / 2);
+        none.keep("a", carry(&planner, 150.0));
+        assert!(none.take("a").is_empty());
+        assert_eq!(none.bytes(), 0);
+    }
+}
