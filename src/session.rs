@@ -678,7 +678,7 @@ mod tests {
     #[test]
     fn history_steps_is_bounded() {
         let settings = SessionSettings {
-            history_steps: Some(33usize.into()),
+            history_steps: Some((MAX_HISTORY_STEPS + 1).into()),
             ..SessionSettings::default()
         };
         assert_eq!(settings.history_len().unwrap_err().field, "history_steps");
