@@ -109,7 +109,11 @@ pub struct SessionSettings {
     pub learn_rates: Option<bool>,
     /// With `learn_rates`: the tolerances of a noisy tracker, as in a fit
     /// (exact data by default).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "FitTolerance::from_object"
+    )]
     pub tolerance: Option<FitTolerance>,
 }
 

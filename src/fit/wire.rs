@@ -79,6 +79,25 @@ pub struct FitTolerance {
     pub look: Option<f64>,
 }
 
+impl FitTolerance {
+    /// An optional tolerance read from a JSON object only: a derived struct
+    /// also takes an array of its fields (`[]` as all defaults), which the
+    /// schema does not allow.
+    ///
+    /// # Errors
+    /// Anything but `null` or an object of the tolerance's fields.
+    pub fn from_object<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<Self>, D::Error> {
+        use serde::de::Error;
+        let Some(fields) = Option::<serde_json::Map<String, serde_json::Value>>::deserialize(d)?
+        else {
+            return Ok(None);
+        };
+        Self::deserialize(serde_json::Value::Object(fields))
+            .map(Some)
+            .map_err(D::Error::custom)
+    }
+}
+
 /// Body of `POST /v1/scenarios/{id}/fit`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
@@ -94,7 +113,11 @@ pub struct FitRequest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub register: Option<bool>,
     /// Tolerances; exact data by default.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "FitTolerance::from_object"
+    )]
     pub tolerance: Option<FitTolerance>,
 }
 

@@ -131,6 +131,12 @@ async fn bad_windows_are_refused_naming_the_field() {
     let mut tol = fit_request();
     tol["tolerance"] = json!({"traceback": -1.0});
     assert_validation(app.post_json(url, &tol).await, "tolerance.traceback").await;
+    // An array is no tolerance, not even an empty one (serde would read
+    // it as a struct's fields in order).
+    let mut listed = fit_request();
+    listed["tolerance"] = json!([]);
+    let res = app.post_json(url, &listed).await;
+    assert_eq!(res.status(), StatusCode::BAD_REQUEST);
     let mut unknown = fit_request();
     unknown["steps"][0]["detections"][0]["z"] = json!(1.0);
     let res = app.post_json(url, &unknown).await;
