@@ -270,9 +270,17 @@ fn idempotency_key(headers: &HeaderMap) -> Result<Option<&str>, ApiError> {
     let Some(value) = headers.get(IDEMPOTENCY_KEY) else {
         return Ok(None);
     };
-    let key = value.to_str().map_err(|_| {
-        ApiError::BadHeader("Idempotency-Key: must be visible ASCII characters".into())
-    })?;
+    // `to_str` also lets tabs through; the documented pattern does not.
+    let key = value
+        .to_str()
+        .ok()
+        .filter(|key| key.bytes().all(|b| (b' '..=b'~').contains(&b)))
+        .filter(|key| !key.starts_with(' ') && !key.ends_with(' '))
+        .ok_or_else(|| {
+            ApiError::BadHeader(
+                "Idempotency-Key: must be visible ASCII characters, with spaces only inside".into(),
+            )
+        })?;
     if key.is_empty() || key.len() > MAX_IDEMPOTENCY_KEY_CHARS {
         return Err(ApiError::BadHeader(format!(
             "Idempotency-Key: must have 1 to {MAX_IDEMPOTENCY_KEY_CHARS} characters, not {}",

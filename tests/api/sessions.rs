@@ -241,6 +241,12 @@ async fn a_step_retried_with_its_idempotency_key_is_answered_not_made_again() {
     // A key over 128 characters is refused.
     let res = step(&"k".repeat(129), 0.0).await.unwrap();
     assert_problem(res, StatusCode::BAD_REQUEST, "Idempotency-Key").await;
+    // So is one with a tab, which the documented pattern excludes; a space
+    // inside is allowed.
+    let res = step("k\t1", 0.0).await.unwrap();
+    assert_problem(res, StatusCode::BAD_REQUEST, "Idempotency-Key").await;
+    let res = step("k 1", 0.0).await.unwrap();
+    assert_eq!(res.status(), StatusCode::OK);
 }
 
 /// A session step's plans are the stateless plan's: the same paths, and
