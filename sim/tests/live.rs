@@ -491,9 +491,48 @@ async fn live_view_draws_obstacles_and_views() {
             == Some("true")
     })
     .await;
-    // Paused, the frame served is the one the page draws.
+    // Paused, the frame served is the one the page draws. Where the run
+    // paused depends on timing: step on, one at a time, to a frame in
+    // which some robot's view is cut by an obstacle.
     tokio::time::sleep(Duration::from_millis(300)).await;
-    let frame = get_json(&url, "frame").await;
+    let mut frame = get_json(&url, "frame").await;
+    let cut_view = |frame: &Value| {
+        frame["sensors"]
+            .as_array()
+            .expect("sensors")
+            .iter()
+            .any(|s| {
+                let cell = Cell {
+                    col: s["col"].as_i64().unwrap() as i32,
+                    row: s["row"].as_i64().unwrap() as i32,
+                };
+                let ty = scenario.type_index(s["type"].as_str().unwrap()).unwrap();
+                let look = scenario.look(ty, cell);
+                let r = look.region.rect;
+                look.from.is_some()
+                    && area(&scenario.view_outline(&look, VIEW_RAYS))
+                        < 0.9 * (r.x1 - r.x0) * (r.y1 - r.y0)
+            })
+    };
+    for _ in 0..100 {
+        if cut_view(&frame) {
+            break;
+        }
+        let before = frame["step"].as_i64().unwrap();
+        reqwest::Client::new()
+            .post(format!("{url}control"))
+            .json(&serde_json::json!({"action": "step"}))
+            .send()
+            .await
+            .and_then(|r| r.error_for_status())
+            .expect("POST control step");
+        let deadline = Instant::now() + Duration::from_secs(10);
+        while frame["step"].as_i64().unwrap() == before {
+            assert!(Instant::now() < deadline, "timed out waiting for a step");
+            tokio::time::sleep(Duration::from_millis(20)).await;
+            frame = get_json(&url, "frame").await;
+        }
+    }
     until(5, "the page to draw the last frame", || async {
         step_now(&c).await == frame["step"].as_i64().unwrap()
     })
