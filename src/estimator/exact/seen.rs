@@ -13,6 +13,21 @@ use crate::geometry::OpenIntervals;
 use crate::obstacle::Sight;
 use crate::scenario::{Look, all_certain};
 
+/// A look's interval on a ray: `(ray, from, to, p_detect)`.
+type RayPiece = (u32, f64, f64, f64);
+
+thread_local! {
+    /// [`RayHits::weighted`]'s pieces and their sorted copy, kept across
+    /// calls: buffers this large come fresh from the kernel, which zeroes
+    /// their pages, and that cost more than filling them (docs/obstacles.md).
+    static WEIGHTED_SCRATCH: std::cell::RefCell<(Vec<RayPiece>, Vec<RayPiece>)> =
+        std::cell::RefCell::default();
+}
+
+/// The most pieces [`WEIGHTED_SCRATCH`] keeps room for between calls
+/// (32 MB each for its two buffers).
+const MAX_KEPT_PIECES: usize = 1 << 20;
+
 /// What the rays of one source saw: per ray, the union of the intervals
 /// seen `s` steps ago, each pushed by `v·s` (the distance a target has flown
 /// since), merged into sorted disjoint intervals. At step `t` the seen set is
@@ -75,11 +90,33 @@ impl RayHits {
         sights: &[Vec<Option<Sight>>],
         speed: f64,
     ) -> Self {
+        WEIGHTED_SCRATCH.with_borrow_mut(|(pieces, sorted)| {
+            pieces.clear();
+            let hits = Self::weighted_in(sr, observed, keys, sights, speed, pieces, sorted);
+            // A scratch grown past the cap is not kept.
+            if pieces.capacity() > MAX_KEPT_PIECES {
+                *pieces = Vec::new();
+                *sorted = Vec::new();
+            }
+            hits
+        })
+    }
+
+    /// [`RayHits::weighted`] with scratch space for the pieces (empty) and
+    /// for them sorted by ray.
+    fn weighted_in(
+        sr: &SourceRays,
+        observed: &[Vec<Look>],
+        keys: &[Vec<Option<LookKey>>],
+        sights: &[Vec<Option<Sight>>],
+        speed: f64,
+        pieces: &mut Vec<RayPiece>,
+        sorted: &mut Vec<RayPiece>,
+    ) -> Self {
         let mut buf = Vec::new();
         let mut visible = Vec::new();
         let o = sr.source.pos;
         let n = sr.dirs.len();
-        let mut pieces: Vec<(u32, f64, f64, f64)> = Vec::new();
         for (s, looks) in observed.iter().enumerate() {
             let shift = speed * s as f64;
             for (i, look) in looks.iter().enumerate() {
@@ -126,14 +163,15 @@ impl RayHits {
         }
         // By ray: a counting sort (the pieces of one ray keep their order).
         let mut counts = vec![0usize; n + 1];
-        for &(m, ..) in &pieces {
+        for &(m, ..) in pieces.iter() {
             counts[m as usize + 1] += 1;
         }
         for m in 0..n {
             counts[m + 1] += counts[m];
         }
-        let mut sorted = vec![(0u32, 0.0, 0.0, 0.0); pieces.len()];
-        for &piece in &pieces {
+        sorted.clear();
+        sorted.resize(pieces.len(), (0u32, 0.0, 0.0, 0.0));
+        for &piece in pieces.iter() {
             let slot = &mut counts[piece.0 as usize];
             sorted[*slot] = piece;
             *slot += 1;
