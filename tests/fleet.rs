@@ -144,6 +144,7 @@ fn run(
                     stats: &stats,
                     rays: &rays,
                     grid: grid.as_ref(),
+                    sights: None,
                 },
                 Situation {
                     observed: &observed,
@@ -359,6 +360,7 @@ fn treating_uncertain_looks_as_certain_is_detected_as_biased() {
                     stats: &stats,
                     rays: &rays,
                     grid: Some(&grid),
+                    sights: None,
                 },
                 Situation {
                     observed: &observed,
@@ -461,6 +463,7 @@ fn fast_and_general_paths_agree_with_mixed_types() {
                     stats: &stats,
                     rays: &rays,
                     grid: Some(&grid),
+                    sights: None,
                 },
                 Situation {
                     observed: &history,

@@ -110,6 +110,7 @@ fn run(setting: &Setting) -> (Vec<(f64, f64)>, f64) {
                     stats: &stats,
                     rays: &rays,
                     grid: grid.as_ref(),
+                    sights: None,
                 },
                 Situation {
                     observed: if setting.withhold_history {

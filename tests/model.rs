@@ -239,6 +239,7 @@ fn run_unbiasedness_with(
                     stats: std::slice::from_ref(&stats),
                     rays: &rays,
                     grid: grid.as_ref(),
+                    sights: None,
                 },
                 Situation {
                     observed: &observed,
@@ -581,6 +582,7 @@ fn fast_and_general_exact_paths_agree() {
                     stats: std::slice::from_ref(&stats),
                     rays,
                     grid: grid.as_ref(),
+                    sights: None,
                 },
                 Situation {
                     observed: &history,

@@ -353,6 +353,7 @@ impl Yard {
                 stats: &self.stats,
                 rays: &self.rays,
                 grid: None,
+                sights: None,
             },
             Situation {
                 observed,

@@ -13,7 +13,7 @@ use crate::codec::{CodecError, Reader, Writer, expect_len};
 use crate::coordination::{Fleet, Objective, coordinate};
 use crate::estimator::{
     Carry, ElementaryGrid, Estimator, ExactEstimator, FirstDetections, PaperEstimator, Precomputed,
-    Situation, SourceRays,
+    SightIndex, Situation, SourceRays,
 };
 use crate::scenario::{Cell, Look, Scenario, ValidationError};
 use crate::stats::Stats;
@@ -36,6 +36,9 @@ pub struct Planner {
     pub stats: Vec<Stats>,
     pub(crate) rays: Vec<SourceRays>,
     pub(crate) grid: Option<ElementaryGrid>,
+    /// What ground looks cannot see, cell by cell, on `rays` (derived from
+    /// the scenario and `rays`, so built again, not stored).
+    sights: Option<SightIndex>,
     /// Time the precomputation took, milliseconds.
     pub precompute_ms: f64,
     /// Which planner this is, for the carries it makes ([`Carry`]): no
@@ -123,11 +126,13 @@ impl Planner {
         }
         SourceRays::index_looks(&mut rays, &scenario);
         progress.advance(1);
+        let sights = SightIndex::new(&scenario, &rays);
         Ok(Planner {
             scenario,
             stats,
             rays,
             grid,
+            sights,
             precompute_ms: started.elapsed().as_secs_f64() * 1e3,
             identity: next_identity(),
         })
@@ -197,11 +202,13 @@ impl Planner {
             None
         };
         r.end()?;
+        let sights = SightIndex::new(&scenario, &rays);
         Ok(Planner {
             scenario,
             stats,
             rays,
             grid,
+            sights,
             precompute_ms: started.elapsed().as_secs_f64() * 1e3,
             identity: next_identity(),
         })
@@ -219,7 +226,8 @@ impl Planner {
         let stats = 3 * self.stats.len() * cells * std::mem::size_of::<f64>() + blocked;
         let grid = self.grid.as_ref().map_or(0, ElementaryGrid::memory_bytes);
         let rays: usize = self.rays.iter().map(SourceRays::memory_bytes).sum();
-        std::mem::size_of::<Self>() + stats + grid + rays
+        let sights = self.sights.as_ref().map_or(0, SightIndex::memory_bytes);
+        std::mem::size_of::<Self>() + stats + grid + rays + sights
     }
 
     /// Validates and plans a request.
@@ -453,6 +461,8 @@ impl Planner {
             stats: &self.stats,
             rays: rays.unwrap_or(&self.rays),
             grid: self.grid.as_ref(),
+            // Indexed on the planner's own rays only.
+            sights: self.sights.as_ref().filter(|_| rays.is_none()),
         }
     }
 

@@ -10,6 +10,7 @@ mod cell_sights;
 mod first;
 mod rays;
 mod seen;
+mod sight_index;
 mod sighted;
 mod stored;
 #[cfg(test)]
@@ -25,6 +26,7 @@ pub use rays::{
     INDEX_CROSSINGS_PER_CELL, MIN_INDEX_CROSSINGS, RAYS_PER_PI, RAYS_PER_PI_SQUARE, SourceRays,
 };
 use seen::RayHits;
+pub use sight_index::SightIndex;
 pub use windows::ONE_WINDOW_RECTANGLES;
 use windows::{SeenRays, StepWindows, Window};
 
@@ -98,6 +100,9 @@ pub struct ExactEstimator<'a> {
     /// With obstacles, per ground sensor, what its looks cannot see over
     /// its reach (empty for an elevated one).
     sights: Vec<cell_sights::SightCache>,
+    /// With obstacles, the scenario's index of what ground looks cannot
+    /// see, when it has one (read before `sights`).
+    sight_index: Option<&'a SightIndex>,
     /// The target classes, each on its source's rays.
     classes: Vec<ClassRays>,
     /// Per class (aligned with `classes`), where its rays crossed what was
@@ -124,6 +129,9 @@ pub struct Precomputed<'a> {
     pub rays: &'a [SourceRays],
     /// Its elementary grid (square fields of view only).
     pub grid: Option<&'a ElementaryGrid>,
+    /// What its ground looks cannot see, cell by cell, on `rays` (see
+    /// [`SightIndex::new`]).
+    pub sights: Option<&'a SightIndex>,
 }
 
 /// What the sensors know and where they are, for one plan.
@@ -259,6 +267,7 @@ impl<'a> ExactEstimator<'a> {
             stats,
             rays,
             grid,
+            sights: sight_index,
         } = precomputed;
         let Situation {
             targets,
@@ -307,6 +316,7 @@ impl<'a> ExactEstimator<'a> {
             known,
             flights,
             sights,
+            sight_index,
             classes,
             seen,
             starts: starts.to_vec(),

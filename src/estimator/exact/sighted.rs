@@ -26,10 +26,13 @@
 //! rectangle of a fill's reach once, by the rays, before the block sums
 //! (`less_what_cut_looks_detect`), since what it detects of a rectangle
 //! does not depend on the cell asking. Blocked sight lines cut a look's
-//! own rectangles, so a look an obstacle cuts stays per cell.
+//! own rectangles, so a look an obstacle cuts stays per cell; the parts of
+//! the rays it does not see are read from the scenario's `sight_index`
+//! when it has one.
 
 use super::ExactEstimator;
 use super::cell_sights::CellSight;
+use super::sight_index::{CellView, hidden_parts};
 use super::windows::{BlockSums, Window};
 use crate::estimator::elementary::{Block, ElementaryGrid, Segment, trace};
 use crate::geometry::{Point, detection_pieces};
@@ -263,7 +266,7 @@ impl ExactEstimator<'_> {
         let ty = &s.types[self.types[sensor]];
         let look = s.look(self.types[sensor], k);
         let fk = look.region;
-        self.with_cell_sight(sensor, k, &look, |sight, hidden| {
+        self.with_cell_sight(sensor, k, &look, |sight, hidden, view| {
             let known: f64 = known
                 .iter()
                 .filter(|&&(p, _)| fk.contains(p) && sight.is_none_or(|v| v.sees(p)))
@@ -279,44 +282,44 @@ impl ExactEstimator<'_> {
                         // square less itself, which rounds).
                         (Some(v), _) if v.blind() => 0.0,
                         (Some(v), Some(hidden)) => {
-                            whole
-                                - self.unseen_sighted(
-                                    &look,
-                                    Some(v),
-                                    Some(hidden),
-                                    t,
-                                    near,
-                                    scratch,
-                                )
+                            whole - self.unseen_hidden(&look, v, hidden, view, t, near, scratch)
                         }
                         _ => whole,
                     }
                 }
-                (None, sight) => self.unseen_sighted(&look, sight, None, t, near, scratch),
+                (None, sight) => self.unseen_sighted(&look, sight, t, near, scratch),
             };
             ty.p_detect * (known + unseen)
         })
     }
 
-    /// Calls `f` with what `sensor`'s `look` at `k` cannot see and a box
+    /// Calls `f` with what `sensor`'s `look` at `k` cannot see, a box
     /// holding the part of its field of view that it misses (`None` for
-    /// both when it sees all of it), from the sensor's cache when `k` is in
-    /// its reach.
+    /// both when it sees all of it) and the scenario's index of the rays'
+    /// hidden parts there, if it has one: from the index, or else from
+    /// the sensor's cache when `k` is in its reach.
     fn with_cell_sight<R>(
         &self,
         sensor: usize,
         k: Cell,
         look: &Look,
-        f: impl FnOnce(Option<&Sight>, Option<&crate::geometry::Rect>) -> R,
+        f: impl FnOnce(Option<&Sight>, Option<&crate::geometry::Rect>, Option<&CellView>) -> R,
     ) -> R {
+        let slot = self.scenario.types[self.types[sensor]].fov_slot;
+        if let Some(view) = self.sight_index.and_then(|index| index.view(slot, k)) {
+            return match &view.sight {
+                Some((v, hidden)) => f(Some(v), hidden.as_ref(), Some(view)),
+                None => f(None, None, None),
+            };
+        }
         let compute = || -> CellSight {
             let sight = self.scenario.sight(look)?;
             let hidden = sight.hidden_within(&look.region.rect);
             Some((sight, hidden))
         };
         let call = |cs: &CellSight| match cs {
-            Some((v, hidden)) => f(Some(v), hidden.as_ref()),
-            None => f(None, None),
+            Some((v, hidden)) => f(Some(v), hidden.as_ref(), None),
+            None => f(None, None, None),
         };
         match self.sights.get(sensor).and_then(|c| c.slot(k)) {
             Some(slot) => call(slot.get_or_init(compute)),
@@ -324,101 +327,141 @@ impl ExactEstimator<'_> {
         }
     }
 
-    /// `U` of `look` at step `t` (see the module docs); with `hidden` (a
-    /// rectangle holding every point of the look's field of view that its
-    /// sight misses), the same integral over the part it does not see
-    /// instead, on the rays that cross `hidden` only.
+    /// `U` of `look` at step `t` (see the module docs) over the part of its
+    /// field of view that `sight` lets it see.
     fn unseen_sighted(
         &self,
         look: &Look,
         sight: Option<&Sight>,
-        hidden: Option<&crate::geometry::Rect>,
         t: usize,
         excluded: &[&Excluded<'_>],
         scratch: &mut Scratch,
     ) -> f64 {
         let fk = &look.region;
-        let crossed = match hidden {
-            Some(&rect) => crate::geometry::Region { rect, disk: None },
-            None => *fk,
-        };
-        let Scratch {
-            buf,
-            parts,
-            cut,
-            pieces,
-            segments,
-            events,
-        } = scratch;
         let mut unseen = 0.0;
+        let mut parts = std::mem::take(&mut scratch.parts);
         for (ri, classes) in self.sources() {
             let sr = &self.rays[ri];
-            let o = sr.source.pos;
-            let Some((a, b)) = sr.range(&crossed, buf) else {
+            let Some((a, b)) = sr.range(fk, &mut scratch.buf) else {
                 continue;
             };
             // A source has at most MAX_SPEED_CLASSES classes.
             let mut sums = [0.0; MAX_SPEED_CLASSES];
             for m in a..b {
-                let (d, inv) = sr.dirs[m];
                 let Some((lo, hi)) = sr.alive_in(m, fk) else {
                     continue;
                 };
                 parts.clear();
                 match sight {
-                    Some(v) => v.visible(o, d, lo, hi, parts),
+                    Some(v) => v.visible(sr.source.pos, sr.dirs[m].0, lo, hi, &mut parts),
                     None => parts.push((lo, hi)),
                 }
-                if hidden.is_some() {
-                    // The gaps between the visible parts, in place.
-                    let n = parts.len();
-                    let mut from = lo;
-                    for i in 0..n {
-                        let (p, q) = parts[i];
-                        if p > from {
-                            parts.push((from, p));
-                        }
-                        from = q;
-                    }
-                    if hi > from {
-                        parts.push((from, hi));
-                    }
-                    parts.drain(..n);
-                }
-                if parts.is_empty() {
-                    continue;
-                }
-                // Where the excluded looks hold this ray, cut into pieces
-                // of one detection probability each.
-                seen_by(excluded, (o, d, inv), (lo, hi), cut, pieces);
-                segments.clear();
-                if !pieces.is_empty() {
-                    detection_pieces(pieces, lo, hi, events, |u, v, q| segments.push((u, v, q)));
-                }
-                for (slot, c) in classes.clone().enumerate() {
-                    let (class, hits) = (&self.classes[c], &self.seen[c]);
-                    let lift = class.speed * t as f64;
-                    let seen = |u: f64, v: f64| {
-                        hits.detected_upto(m, v - lift) - hits.detected_upto(m, u - lift)
-                    };
-                    let mut sum = 0.0;
-                    for &(p, q) in parts.iter() {
-                        sum += (q - p) - seen(p, q);
-                        for &(u, v, qx) in segments.iter() {
-                            let (u, v) = (u.max(p), v.min(q));
-                            if v > u {
-                                sum -= qx * ((v - u) - seen(u, v));
-                            }
-                        }
-                    }
-                    sums[slot] += sum;
+                if !parts.is_empty() {
+                    let ray = (ri, classes.clone(), m);
+                    self.unseen_on_ray(ray, (lo, hi), &parts, t, excluded, scratch, &mut sums);
                 }
             }
             for (slot, c) in classes.enumerate() {
                 unseen += self.classes[c].weight * sums[slot];
             }
         }
+        scratch.parts = parts;
         unseen
+    }
+
+    /// `U` of `look` at step `t` over the part of its field of view that
+    /// its sight `v` hides, which `hidden` holds: on the rays that cross
+    /// `hidden` only, their hidden parts read from `view` when the
+    /// scenario indexed them, the same parts otherwise worked out here.
+    #[allow(clippy::too_many_arguments)]
+    fn unseen_hidden(
+        &self,
+        look: &Look,
+        v: &Sight,
+        hidden: &crate::geometry::Rect,
+        view: Option<&CellView>,
+        t: usize,
+        excluded: &[&Excluded<'_>],
+        scratch: &mut Scratch,
+    ) -> f64 {
+        let crossed = crate::geometry::Region {
+            rect: *hidden,
+            disk: None,
+        };
+        let mut unseen = 0.0;
+        let mut buf = std::mem::take(&mut scratch.buf);
+        for (ri, classes) in self.sources() {
+            // A source has at most MAX_SPEED_CLASSES classes.
+            let mut sums = [0.0; MAX_SPEED_CLASSES];
+            let mut on_ray = |m: usize, lo: f64, hi: f64, parts: &[(f64, f64)]| {
+                let ray = (ri, classes.clone(), m);
+                self.unseen_on_ray(ray, (lo, hi), parts, t, excluded, scratch, &mut sums);
+            };
+            match view {
+                Some(view) => {
+                    for (ray, parts) in view.rays_of(ri) {
+                        on_ray(ray.m as usize, ray.lo, ray.hi, parts);
+                    }
+                }
+                None => hidden_parts(&self.rays[ri], &look.region, &crossed, v, &mut buf, on_ray),
+            }
+            for (slot, c) in classes.enumerate() {
+                unseen += self.classes[c].weight * sums[slot];
+            }
+        }
+        scratch.buf = buf;
+        unseen
+    }
+
+    /// Adds to `sums` (per class of the ray's source) the unseen mass at
+    /// step `t` on `parts` of ray `m` of source `ri` (`classes` its
+    /// classes), whose part in the field of view is `[lo, hi]`: the seen
+    /// set's and the excluded looks' detections taken off.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn unseen_on_ray(
+        &self,
+        (ri, classes, m): (usize, std::ops::Range<usize>, usize),
+        (lo, hi): (f64, f64),
+        parts: &[(f64, f64)],
+        t: usize,
+        excluded: &[&Excluded<'_>],
+        scratch: &mut Scratch,
+        sums: &mut [f64; MAX_SPEED_CLASSES],
+    ) {
+        let Scratch {
+            cut,
+            pieces,
+            segments,
+            events,
+            ..
+        } = scratch;
+        let sr = &self.rays[ri];
+        let (d, inv) = sr.dirs[m];
+        // Where the excluded looks hold this ray, cut into pieces of one
+        // detection probability each.
+        seen_by(excluded, (sr.source.pos, d, inv), (lo, hi), cut, pieces);
+        segments.clear();
+        if !pieces.is_empty() {
+            detection_pieces(pieces, lo, hi, events, |u, v, q| segments.push((u, v, q)));
+        }
+        for (slot, c) in classes.enumerate() {
+            let (class, hits) = (&self.classes[c], &self.seen[c]);
+            let lift = class.speed * t as f64;
+            let seen =
+                |u: f64, v: f64| hits.detected_upto(m, v - lift) - hits.detected_upto(m, u - lift);
+            let mut sum = 0.0;
+            for &(p, q) in parts {
+                sum += (q - p) - seen(p, q);
+                for &(u, v, qx) in segments.iter() {
+                    let (u, v) = (u.max(p), v.min(q));
+                    if v > u {
+                        sum -= qx * ((v - u) - seen(u, v));
+                    }
+                }
+            }
+            sums[slot] += sum;
+        }
     }
 
     /// Takes off each rectangle of `win` (a window over a block) what the

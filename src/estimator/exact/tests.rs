@@ -59,6 +59,7 @@ fn intervals_past_the_exit_change_no_value() {
                     stats: &stats,
                     rays,
                     grid: Some(&grid),
+                    sights: None,
                 },
                 Situation {
                     observed: &observed,
@@ -424,15 +425,19 @@ fn windows_against_per_cell(
         .collect();
     let horizon = 3;
     // The rays (indexed, walked) and the grid, if any.
-    let build = |walk: bool, with_grid: bool| {
+    let index = super::SightIndex::new(s, &rays);
+    assert!(index.is_some(), "a scenario this small is indexed");
+    let build = |walk: bool, with_grid: bool, with_index: bool| {
         let rays = if walk { &walked } else { &rays };
         let grid = with_grid.then_some(&grid);
+        let sights = index.as_ref().filter(|_| with_index);
         let est = ExactEstimator::new(
             Precomputed {
                 scenario: s,
                 stats: &stats,
                 rays,
                 grid,
+                sights,
             },
             Situation {
                 observed: &observed,
@@ -445,10 +450,17 @@ fn windows_against_per_cell(
         est.prepare();
         est
     };
-    let per_cell = build(false, false);
+    let per_cell = build(false, false, false);
+    // Without the sight index, against which the index must give the
+    // same values to the bit.
+    let plain = build(false, true, false);
     let (mut windowed, mut compared) = (0, 0);
-    for (label, walk) in [("indexed", false), ("walked", true)] {
-        let est = build(walk, true);
+    for (label, walk, with_index) in [
+        ("indexed", false, false),
+        ("walked", true, false),
+        ("sight index", false, true),
+    ] {
+        let est = build(walk, true, with_index);
         for (i, (&start, &ty)) in starts.iter().zip(&types).enumerate() {
             let speed = s.types[ty].speed;
             for x in 0..=excluded_looks.len() {
@@ -458,6 +470,13 @@ fn windows_against_per_cell(
                 for t in 1..=horizon {
                     est.fill(i, start, t, excluded, &mut a);
                     per_cell.fill(i, start, t, excluded, &mut b);
+                }
+                if with_index {
+                    let mut c = ValueGrid::with_motion(horizon, speed, |_, _| true);
+                    for t in 1..=horizon {
+                        plain.fill(i, start, t, excluded, &mut c);
+                    }
+                    assert_eq!(a.to_nested(), c.to_nested(), "sensor {i} excluded {x}");
                 }
                 for (va, vb) in a
                     .to_nested()
@@ -490,6 +509,10 @@ fn windows_against_per_cell(
                             est.value(i, k, t, excluded),
                             per_cell.value(i, k, t, excluded),
                         );
+                        if with_index {
+                            let vc = plain.value(i, k, t, excluded);
+                            assert_eq!(va.to_bits(), vc.to_bits(), "{k:?} t={t}");
+                        }
                         assert!(
                             (va - vb).abs() <= 1e-9 * (1.0 + vb.abs()),
                             "{label} value sensor {i} {k:?} t={t} excluded {x}: {va} against {vb}"
