@@ -29,6 +29,15 @@ impl JobLimits {
         jobs: 1,
         queue: 16,
     };
+
+    /// The predicted wall time of precomputing `s`
+    /// ([`predicted_precompute_ms`]) when it is above
+    /// `sync_precompute_ms`: such a precompute runs as a job, never
+    /// inline in a request.
+    pub fn too_long_inline(&self, s: &Scenario) -> Option<f64> {
+        let predicted = predicted_precompute_ms(s);
+        (predicted > self.sync_precompute_ms).then_some(predicted)
+    }
 }
 
 impl Default for JobLimits {

@@ -33,10 +33,7 @@ use std::time::{Duration, Instant};
 
 use super::cache::PlannerCache;
 use super::error::CatalogError;
-use super::jobs::{
-    Entry, Job, JobLimits, JobStatus, Pool, entry_id, precompute, precompute_on,
-    predicted_precompute_ms,
-};
+use super::jobs::{Entry, Job, JobLimits, JobStatus, Pool, entry_id, precompute, precompute_on};
 use super::shared;
 use crate::metric_names;
 use crate::planner::Planner;
@@ -152,7 +149,7 @@ impl Registry {
         use rayon::prelude::*;
         let (now, later): (Vec<Scenario>, Vec<Scenario>) = stored
             .into_iter()
-            .partition(|s| predicted_precompute_ms(s) <= limits.sync_precompute_ms);
+            .partition(|s| limits.too_long_inline(s).is_none());
         let mut scenarios: BTreeMap<String, Entry> = builtins()
             .into_iter()
             .map(|s| (s.id.clone(), Entry::Ready(Arc::new(Planner::new(s)))))
@@ -367,7 +364,7 @@ impl Registry {
             .map_err(CatalogError::from)?
             .ok_or_else(|| CatalogError::NotFound(id.to_owned()))?;
         let scenario = row.scenario;
-        if predicted_precompute_ms(&scenario) > self.limits().sync_precompute_ms {
+        if self.limits().too_long_inline(&scenario).is_some() {
             tracing::info!(%id, "a stored scenario is precomputed here as a job");
             let (entry, _) = self.enqueue(scenario);
             let status = self.entry(id).and_then(|(_, status)| status);

@@ -13,7 +13,7 @@ use super::error::ApiError;
 use super::middleware::RequestStart;
 use super::state::AppState;
 use crate::cancel::{CancelToken, Progress};
-use crate::catalog::{CatalogError, precompute_cancellable, predicted_precompute_ms};
+use crate::catalog::{CatalogError, precompute_cancellable};
 use crate::cost;
 use crate::estimator::Carry;
 use crate::metric_names;
@@ -207,12 +207,11 @@ pub(super) async fn resolve_scenario(
             match registered_or_cached(state, &scenario.id)? {
                 Some(p) => p,
                 None => {
-                    let predicted_ms = predicted_precompute_ms(&scenario);
-                    let budget_ms = state.registry.limits().sync_precompute_ms;
-                    if predicted_ms > budget_ms {
+                    let limits = state.registry.limits();
+                    if let Some(predicted_ms) = limits.too_long_inline(&scenario) {
                         return Err(ApiError::PrecomputeTooCostly {
                             predicted_ms,
-                            budget_ms,
+                            budget_ms: limits.sync_precompute_ms,
                         });
                     }
                     let cache = state.cache.clone();

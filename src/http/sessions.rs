@@ -25,7 +25,6 @@ use super::middleware::RequestStart;
 use super::planning::{plan_admitted_carried, resolve_scenario};
 use super::session_store::Refreshed;
 use super::state::AppState;
-use crate::catalog::predicted_precompute_ms;
 use crate::fit::SourceRate;
 use crate::limits::{MAX_HORIZON, MAX_IDEMPOTENCY_KEY_CHARS, MAX_MIN_SEPARATION, MAX_TARGETS};
 use crate::metric_names;
@@ -153,9 +152,9 @@ pub async fn create(
     if settings.learn_rates == Some(true) {
         // A learning session precomputes its scenario again as its rates
         // move: only a scenario precomputed at once may learn.
-        let predicted_ms = predicted_precompute_ms(&planner.scenario);
-        let budget_ms = state.registry.limits().sync_precompute_ms;
-        if predicted_ms > budget_ms {
+        let limits = state.registry.limits();
+        if let Some(predicted_ms) = limits.too_long_inline(&planner.scenario) {
+            let budget_ms = limits.sync_precompute_ms;
             return Err(ValidationError::new(
                 "learn_rates",
                 format!(

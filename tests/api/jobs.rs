@@ -450,3 +450,28 @@ async fn a_small_registration_is_not_queued_behind_a_job() {
     assert!(took < Duration::from_secs(1), "201 after {took:?}");
     assert_eq!(app.delete(&path).await.status(), StatusCode::NO_CONTENT);
 }
+
+/// A learning session precomputes its scenario again as its rates move,
+/// inline: past the synchronous budget it is refused (422 naming
+/// `learn_rates`), while a plain session of the same scenario is opened.
+#[tokio::test]
+async fn a_learning_session_over_the_inline_budget_is_refused() {
+    let app = jobs_app(1, 4).await;
+    let res = app
+        .post_json(
+            "/v1/sessions",
+            &json!({"scenario_id": "paper-v10", "learn_rates": true}),
+        )
+        .await;
+    let body = assert_problem(res, StatusCode::UNPROCESSABLE_ENTITY, "learn_rates").await;
+    assert!(
+        body["detail"]
+            .as_str()
+            .is_some_and(|d| d.contains("--sync-precompute-ms")),
+        "{body}"
+    );
+    let res = app
+        .post_json("/v1/sessions", &json!({"scenario_id": "paper-v10"}))
+        .await;
+    assert_eq!(res.status(), StatusCode::CREATED);
+}
