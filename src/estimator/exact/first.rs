@@ -94,6 +94,17 @@ impl Profile {
     }
 }
 
+/// Scratch space of [`FirstDetections::pieces`], kept across the looks of
+/// one call site: growing fresh vectors per look cost more than the
+/// pieces.
+#[derive(Debug, Default)]
+struct PieceScratch {
+    buf: Vec<Point>,
+    /// The look's part of each ray of one source: `(ray, lo, hi)`.
+    on_rays: Vec<(u32, f64, f64)>,
+    visible: Vec<(f64, f64)>,
+}
+
 /// What the extra looks of a search detect over the history, for the keys
 /// they meet: per key, the merged profile of both.
 #[derive(Debug)]
@@ -160,12 +171,15 @@ impl<'e> FirstDetections<'e> {
     }
 
     /// Appends the pieces of `look` taken at step `t`, sorted by key.
-    fn pieces(&self, look: &Look, t: usize, out: &mut Vec<Piece>, buf: &mut Vec<Point>) {
-        let mut on_rays: Vec<(u32, f64, f64)> = Vec::new();
+    fn pieces(&self, look: &Look, t: usize, out: &mut Vec<Piece>, scratch: &mut PieceScratch) {
+        let PieceScratch {
+            buf,
+            on_rays,
+            visible,
+        } = scratch;
         // With obstacles, only what the look sees of each ray, before a
         // building ends the flights along it (see `sighted`).
         let sight = self.est.scenario.sight(look);
-        let mut visible = Vec::new();
         for (ri, sr) in self.est.rays.iter().enumerate() {
             let classes = self.classes_of_rays[ri].clone();
             if classes.is_empty() {
@@ -186,7 +200,7 @@ impl<'e> FirstDetections<'e> {
                     None => {}
                     Some(v) => {
                         visible.clear();
-                        v.visible(sr.source.pos, d, lo, hi.max(lo), &mut visible);
+                        v.visible(sr.source.pos, d, lo, hi.max(lo), visible);
                         on_rays.extend(
                             visible
                                 .iter()
@@ -215,7 +229,7 @@ impl<'e> FirstDetections<'e> {
     /// look of step `t` detects and no look of an earlier step did.
     pub fn by_step(&self, looks: &[Vec<Look>]) -> Vec<f64> {
         let horizon = looks.len();
-        let mut buf = Vec::new();
+        let mut buf = PieceScratch::default();
         // (step, piece), sorted by key then step.
         let mut all: Vec<(usize, Piece)> = Vec::new();
         let mut one = Vec::new();
@@ -269,7 +283,7 @@ impl<'e> FirstDetections<'e> {
     /// The pieces of `extra`'s looks (`extra[t − 1]` taken at step `t`),
     /// step by step.
     fn pieces_of(&self, extra: &[Vec<Look>]) -> Vec<Piece> {
-        let mut buf = Vec::new();
+        let mut buf = PieceScratch::default();
         let mut pieces = Vec::new();
         for (t, step) in extra.iter().enumerate() {
             for look in step {
@@ -285,7 +299,7 @@ impl<'e> FirstDetections<'e> {
     /// stops where its search built them.
     fn pieces_on(&self, paths: &[&[Cell]], sensors: &[usize], horizon: usize) -> Vec<Piece> {
         let s = self.est.scenario;
-        let mut buf = Vec::new();
+        let mut buf = PieceScratch::default();
         let mut pieces = Vec::new();
         for t in 1..=horizon {
             for &q in sensors {
@@ -310,8 +324,13 @@ impl<'e> FirstDetections<'e> {
         let mut keys = Vec::new();
         let mut merged = Profile::default();
         merged.start.push(0);
+        // About as many pieces as the extra looks' and the history's on
+        // their keys: reserved at once, not grown.
+        merged.pieces.reserve(2 * pieces.len());
+        merged.before.reserve(2 * pieces.len());
         let mut intervals: Vec<(f64, f64, f64)> = Vec::new();
         let mut events = Vec::new();
+        let mut out = Vec::new();
         for group in pieces.chunk_by(|x, y| x.key == y.key) {
             let key = group[0].key;
             intervals.clear();
@@ -322,12 +341,12 @@ impl<'e> FirstDetections<'e> {
                 .iter()
                 .map(|x| x.1)
                 .fold(f64::NEG_INFINITY, f64::max);
-            let mut out = Vec::new();
+            out.clear();
             detection_pieces(&intervals, lo, hi, &mut events, |a, b, d| {
                 out.push((a, b, d))
             });
             keys.push(key);
-            merged.push_key(out);
+            merged.push_key(out.iter().copied());
         }
         Background { keys, merged }
     }
@@ -353,7 +372,11 @@ impl<'e> FirstDetections<'e> {
                 history_ends: Vec::new(),
                 per_key: 1,
             };
-            let mut buf = Vec::new();
+            let mut buf = PieceScratch::default();
+            let mut reachable = 0;
+            for t in 1..=horizon {
+                grid.for_each_reachable(t, |_, _| reachable += 1);
+            }
             for t in 1..=horizon {
                 grid.for_each_reachable(t, |dc, dr| {
                     let k = Cell {
@@ -365,6 +388,13 @@ impl<'e> FirstDetections<'e> {
                     }
                     let first = stops.pieces.len();
                     self.pieces(&s.look(ty, k), t, &mut stops.pieces, &mut buf);
+                    if first == 0 {
+                        // Room for about as many pieces at every stop as
+                        // at the first, at once rather than by growing.
+                        let more = stops.pieces.len() * reachable;
+                        stops.pieces.reserve(more);
+                        stops.history_ends.reserve(more);
+                    }
                     stops
                         .history_ends
                         .extend(stops.pieces[first..].iter().map(|p| {
