@@ -5,11 +5,18 @@ use std::sync::OnceLock;
 
 use crate::geometry::Rect;
 use crate::obstacle::Sight;
-use crate::scenario::Cell;
+use crate::scenario::{Cell, Look, Scenario};
 
 /// What a ground look at a cell cannot see, and a box holding the part of
 /// its field of view that it misses (`None` when it sees all of it).
 pub(super) type CellSight = Option<(Sight, Option<Rect>)>;
+
+/// The [`CellSight`] of `look` in `scenario`.
+pub(super) fn cell_sight(scenario: &Scenario, look: &Look) -> CellSight {
+    let sight = scenario.sight(look)?;
+    let hidden = sight.hidden_within(&look.region.rect);
+    Some((sight, hidden))
+}
 
 /// One sensor's [`CellSight`]s over the cells it may reach, each worked
 /// out on first use: a plan asks the same cells at every step and pass.

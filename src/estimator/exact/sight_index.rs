@@ -12,7 +12,7 @@
 
 use rayon::prelude::*;
 
-use super::cell_sights::CellSight;
+use super::cell_sights::{CellSight, cell_sight};
 use super::rays::SourceRays;
 use crate::geometry::Region;
 use crate::scenario::{Cell, Scenario};
@@ -50,8 +50,8 @@ pub(super) struct CellView {
 }
 
 impl CellView {
-    /// The view of `look`-like sensors at one cell: `sight` and `hidden`
-    /// are the look's, `region` its field of view.
+    /// The view of a ground look at one cell: `sight` is the look's,
+    /// `region` its field of view.
     fn new(rays: &[SourceRays], region: &Region, sight: CellSight) -> Self {
         let mut view = CellView {
             by_source: vec![0],
@@ -152,10 +152,9 @@ pub(super) fn hidden_parts(
 #[derive(Debug, Default)]
 pub struct SightIndex {
     /// Per field of view (the scenario's `fovs`), the index of its first
-    /// cell's view in `views`, if it is indexed (a ground one).
+    /// cell's view in `views` (cells in row-major order), if it is
+    /// indexed (a ground one).
     first: Vec<Option<usize>>,
-    cols: i32,
-    rows: i32,
     views: Vec<CellView>,
 }
 
@@ -193,28 +192,21 @@ impl SightIndex {
                 .into_par_iter()
                 .map(|i| {
                     let look = scenario.look(ty, scenario.cell_at(i));
-                    let sight = scenario.sight(&look).map(|v| {
-                        let hidden = v.hidden_within(&look.region.rect);
-                        (v, hidden)
-                    });
-                    CellView::new(rays, &look.region, sight)
+                    CellView::new(rays, &look.region, cell_sight(scenario, &look))
                 })
                 .collect();
             views.extend(slot);
         }
-        Some(SightIndex {
-            first,
-            cols: scenario.cols,
-            rows: scenario.rows,
-            views,
-        })
+        Some(SightIndex { first, views })
     }
 
-    /// The view of the ground field of view `slot` at `k`, if indexed.
-    pub(super) fn view(&self, slot: usize, k: Cell) -> Option<&CellView> {
+    /// The view of the ground field of view `slot` at `k`, if indexed
+    /// (`scenario` is the one the index was built for).
+    pub(super) fn view(&self, scenario: &Scenario, slot: usize, k: Cell) -> Option<&CellView> {
         let first = (*self.first.get(slot)?)?;
-        let on = k.col >= 0 && k.row >= 0 && k.col < self.cols && k.row < self.rows;
-        on.then(|| &self.views[first + (k.row * self.cols + k.col) as usize])
+        scenario
+            .on_lattice(k)
+            .then(|| &self.views[first + scenario.index(k)])
     }
 
     /// Approximate heap memory held, bytes.

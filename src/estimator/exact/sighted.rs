@@ -31,7 +31,7 @@
 //! when it has one.
 
 use super::ExactEstimator;
-use super::cell_sights::CellSight;
+use super::cell_sights::{CellSight, cell_sight};
 use super::sight_index::{CellView, hidden_parts};
 use super::windows::{BlockSums, Window};
 use crate::estimator::elementary::{Block, ElementaryGrid, Segment, trace};
@@ -306,17 +306,16 @@ impl ExactEstimator<'_> {
         f: impl FnOnce(Option<&Sight>, Option<&crate::geometry::Rect>, Option<&CellView>) -> R,
     ) -> R {
         let slot = self.scenario.types[self.types[sensor]].fov_slot;
-        if let Some(view) = self.sight_index.and_then(|index| index.view(slot, k)) {
+        if let Some(view) = self
+            .sight_index
+            .and_then(|index| index.view(self.scenario, slot, k))
+        {
             return match &view.sight {
                 Some((v, hidden)) => f(Some(v), hidden.as_ref(), Some(view)),
                 None => f(None, None, None),
             };
         }
-        let compute = || -> CellSight {
-            let sight = self.scenario.sight(look)?;
-            let hidden = sight.hidden_within(&look.region.rect);
-            Some((sight, hidden))
-        };
+        let compute = || cell_sight(self.scenario, look);
         let call = |cs: &CellSight| match cs {
             Some((v, hidden)) => f(Some(v), hidden.as_ref(), None),
             None => f(None, None, None),
