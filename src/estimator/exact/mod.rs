@@ -97,8 +97,8 @@ pub struct ExactEstimator<'a> {
     /// With obstacles, per known target, its speed and how far it flies
     /// before a building ends its flight ([`crate::obstacle::Obstacles::flight`]).
     flights: Vec<(f64, f64)>,
-    /// With obstacles, per ground sensor, what its looks cannot see over
-    /// its reach (empty for an elevated one).
+    /// With obstacles and no `sight_index`, per ground sensor, what its
+    /// looks cannot see over its reach (empty for an elevated one).
     sights: Vec<cell_sights::SightCache>,
     /// With obstacles, the scenario's index of what ground looks cannot
     /// see, when it has one (read before `sights`).
@@ -291,7 +291,9 @@ impl<'a> ExactEstimator<'a> {
         } else {
             Vec::new()
         };
-        let sights = if scenario.has_obstacles() {
+        // The scenario's index, when it has one, holds every ground
+        // field of view at every cell already.
+        let sights = if scenario.has_obstacles() && sight_index.is_none() {
             starts
                 .iter()
                 .zip(types)
