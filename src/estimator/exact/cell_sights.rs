@@ -1,5 +1,6 @@
 //! What the looks of a ground sensor at each cell of its reach cannot
-//! see, worked out once per plan (see `sighted`).
+//! see, and the unseen mass they miss there, worked out once per plan
+//! (see `sighted`).
 
 use std::sync::OnceLock;
 
@@ -18,34 +19,52 @@ pub(super) fn cell_sight(scenario: &Scenario, look: &Look) -> CellSight {
     Some((sight, hidden))
 }
 
-/// One sensor's [`CellSight`]s over the cells it may reach, each worked
-/// out on first use: a plan asks the same cells at every step and pass.
-pub(super) struct SightCache {
+/// One value per cell of a sensor's reach (and per layer: a step, say),
+/// each worked out on first use: a plan asks the same cells at every step
+/// and in each of its searches.
+pub(super) struct ReachCache<T> {
     start: Cell,
     extent: i32,
-    cells: Vec<OnceLock<CellSight>>,
+    layers: usize,
+    cells: Vec<OnceLock<T>>,
 }
 
-impl SightCache {
-    /// The cache of a sensor at `start` that moves at most `extent` cells.
-    pub(super) fn new(start: Cell, extent: i32) -> Self {
+/// One sensor's [`CellSight`]s over the cells it may reach.
+pub(super) type SightCache = ReachCache<CellSight>;
+
+impl<T> ReachCache<T> {
+    /// The cache of a sensor at `start` that moves at most `extent` cells,
+    /// with `layers` values per cell.
+    pub(super) fn new(start: Cell, extent: i32, layers: usize) -> Self {
         // A negative extent (an elevated sensor's): no cell.
         let side = (2 * extent + 1).max(0) as usize;
-        SightCache {
+        ReachCache {
             start,
             extent,
-            cells: (0..side * side).map(|_| OnceLock::new()).collect(),
+            layers,
+            cells: (0..side * side * layers).map(|_| OnceLock::new()).collect(),
         }
     }
 
-    /// `k`'s slot, if it is in reach.
-    pub(super) fn slot(&self, k: Cell) -> Option<&OnceLock<CellSight>> {
+    /// `k`'s slot in `layer`, if `k` is in reach and `layer` below the
+    /// cache's layers.
+    pub(super) fn slot(&self, k: Cell, layer: usize) -> Option<&OnceLock<T>> {
         let (dc, dr) = (k.col - self.start.col, k.row - self.start.row);
-        if dc.abs() > self.extent || dr.abs() > self.extent {
+        if dc.abs() > self.extent || dr.abs() > self.extent || layer >= self.layers {
             return None;
         }
-        let side = 2 * self.extent + 1;
-        self.cells
-            .get(((dr + self.extent) * side + dc + self.extent) as usize)
+        let side = (2 * self.extent + 1) as usize;
+        let at = ((dr + self.extent) as usize * side + (dc + self.extent) as usize) * self.layers;
+        self.cells.get(at + layer)
     }
+}
+
+/// What a plan keeps of one sensor's looks over its reach, with obstacles
+/// (nothing for an elevated sensor, which sees its whole square).
+pub(super) struct GroundReach {
+    /// Their [`CellSight`]s, when the scenario has no sight index.
+    pub(super) sights: Option<SightCache>,
+    /// Per step of the horizon (layer `t − 1`), the unseen mass that they
+    /// do not see before any exclusion: the same in every search.
+    pub(super) hidden_unseen: ReachCache<f64>,
 }

@@ -97,11 +97,11 @@ pub struct ExactEstimator<'a> {
     /// With obstacles, per known target, its speed and how far it flies
     /// before a building ends its flight ([`crate::obstacle::Obstacles::flight`]).
     flights: Vec<(f64, f64)>,
-    /// With obstacles and no `sight_index`, per ground sensor, what its
-    /// looks cannot see over its reach (empty for an elevated one).
-    sights: Vec<cell_sights::SightCache>,
+    /// With obstacles, per sensor, what the plan keeps of its looks over
+    /// its reach.
+    ground: Vec<cell_sights::GroundReach>,
     /// With obstacles, the scenario's index of what ground looks cannot
-    /// see, when it has one (read before `sights`).
+    /// see, when it has one (read before `ground`'s caches).
     sight_index: Option<&'a SightIndex>,
     /// The target classes, each on its source's rays.
     classes: Vec<ClassRays>,
@@ -291,20 +291,28 @@ impl<'a> ExactEstimator<'a> {
         } else {
             Vec::new()
         };
-        // The scenario's index, when it has one, holds every ground
-        // field of view at every cell already.
-        let sights = if scenario.has_obstacles() && sight_index.is_none() {
+        // How far each sensor may move: none for an elevated one, which
+        // sees its whole square.
+        let ground = if scenario.has_obstacles() {
             starts
                 .iter()
                 .zip(types)
                 .map(|(&start, &ty)| {
                     let ty = &scenario.types[ty];
+                    // An elevated sensor sees its whole square: no cell.
                     let extent = if ty.elevated {
                         -1
                     } else {
                         (ty.speed * horizon) as i32
                     };
-                    cell_sights::SightCache::new(start, extent)
+                    cell_sights::GroundReach {
+                        // The scenario's index, when it has one, holds every
+                        // ground field of view at every cell already.
+                        sights: sight_index
+                            .is_none()
+                            .then(|| cell_sights::SightCache::new(start, extent, 1)),
+                        hidden_unseen: cell_sights::ReachCache::new(start, extent, horizon),
+                    }
                 })
                 .collect()
         } else {
@@ -317,7 +325,7 @@ impl<'a> ExactEstimator<'a> {
             grid,
             known,
             flights,
-            sights,
+            ground,
             sight_index,
             classes,
             seen,

@@ -282,7 +282,8 @@ impl ExactEstimator<'_> {
                         // square less itself, which rounds).
                         (Some(v), _) if v.blind() => 0.0,
                         (Some(v), Some(hidden)) => {
-                            whole - self.unseen_hidden(&look, v, hidden, view, t, near, scratch)
+                            let cell = (sensor, k, &look);
+                            whole - self.unseen_hidden(cell, (v, hidden), view, t, near, scratch)
                         }
                         _ => whole,
                     }
@@ -320,7 +321,8 @@ impl ExactEstimator<'_> {
             Some((v, hidden)) => f(Some(v), hidden.as_ref(), None),
             None => f(None, None, None),
         };
-        match self.sights.get(sensor).and_then(|c| c.slot(k)) {
+        let cache = self.ground.get(sensor).and_then(|g| g.sights.as_ref());
+        match cache.and_then(|c| c.slot(k, 0)) {
             Some(slot) => call(slot.get_or_init(compute)),
             None => call(&compute()),
         }
@@ -357,7 +359,8 @@ impl ExactEstimator<'_> {
                 }
                 if !parts.is_empty() {
                     let ray = (ri, classes.clone(), m);
-                    self.unseen_on_ray(ray, (lo, hi), &parts, t, excluded, scratch, &mut sums);
+                    let on = (lo, hi, &parts[..]);
+                    self.unseen_on_ray(ray, on, t, (excluded, true), scratch, &mut sums);
                 }
             }
             for (slot, c) in classes.enumerate() {
@@ -368,16 +371,18 @@ impl ExactEstimator<'_> {
         unseen
     }
 
-    /// `U` of `look` at step `t` over the part of its field of view that
-    /// its sight `v` hides, which `hidden` holds: on the rays that cross
-    /// `hidden` only, their hidden parts read from `view` when the
-    /// scenario indexed them, the same parts otherwise worked out here.
+    /// `U` of `sensor`'s `look` at `k` at step `t` over the part of its
+    /// field of view that its sight `v` hides, which `hidden` holds: on the
+    /// rays that cross `hidden` only, their hidden parts read from `view`
+    /// when the scenario indexed them, the same parts otherwise worked out
+    /// here. The seen set's part is the same in every search of a plan, so
+    /// it is kept per cell and step; the excluded looks' part is taken off
+    /// it.
     #[allow(clippy::too_many_arguments)]
     fn unseen_hidden(
         &self,
-        look: &Look,
-        v: &Sight,
-        hidden: &crate::geometry::Rect,
+        (sensor, k, look): (usize, Cell, &Look),
+        (v, hidden): (&Sight, &crate::geometry::Rect),
         view: Option<&CellView>,
         t: usize,
         excluded: &[&Excluded<'_>],
@@ -387,6 +392,37 @@ impl ExactEstimator<'_> {
             rect: *hidden,
             disk: None,
         };
+        let hidden = (look, v, &crossed, view);
+        let kept = t
+            .checked_sub(1)
+            .and_then(|layer| self.ground.get(sensor)?.hidden_unseen.slot(k, layer));
+        let mut seen_set = || self.on_hidden_rays(hidden, t, (&[], true), scratch);
+        let unseen = match kept {
+            Some(slot) => *slot.get_or_init(seen_set),
+            None => seen_set(),
+        };
+        // Only the excluded looks that may meet the hidden rays' box.
+        let near: Vec<&Excluded<'_>> = excluded
+            .iter()
+            .copied()
+            .filter(|(x, _)| x.region.may_overlap(&crossed))
+            .collect();
+        if near.is_empty() {
+            return unseen;
+        }
+        unseen + self.on_hidden_rays(hidden, t, (&near, false), scratch)
+    }
+
+    /// [`ExactEstimator::unseen_on_ray`] summed over the hidden parts of
+    /// the rays that cross `crossed`, `v` being the sight of `look` and
+    /// `view` its index entry (if any), weighted by class.
+    fn on_hidden_rays(
+        &self,
+        (look, v, crossed, view): (&Look, &Sight, &crate::geometry::Region, Option<&CellView>),
+        t: usize,
+        excluded: (&[&Excluded<'_>], bool),
+        scratch: &mut Scratch,
+    ) -> f64 {
         let mut unseen = 0.0;
         let mut buf = std::mem::take(&mut scratch.buf);
         for (ri, classes) in self.sources() {
@@ -394,7 +430,7 @@ impl ExactEstimator<'_> {
             let mut sums = [0.0; MAX_SPEED_CLASSES];
             let mut on_ray = |m: usize, lo: f64, hi: f64, parts: &[(f64, f64)]| {
                 let ray = (ri, classes.clone(), m);
-                self.unseen_on_ray(ray, (lo, hi), parts, t, excluded, scratch, &mut sums);
+                self.unseen_on_ray(ray, (lo, hi, parts), t, excluded, scratch, &mut sums);
             };
             match view {
                 Some(view) => {
@@ -402,7 +438,7 @@ impl ExactEstimator<'_> {
                         on_ray(ray.m as usize, ray.lo, ray.hi, parts);
                     }
                 }
-                None => hidden_parts(&self.rays[ri], &look.region, &crossed, v, &mut buf, on_ray),
+                None => hidden_parts(&self.rays[ri], &look.region, crossed, v, &mut buf, on_ray),
             }
             for (slot, c) in classes.enumerate() {
                 unseen += self.classes[c].weight * sums[slot];
@@ -415,16 +451,15 @@ impl ExactEstimator<'_> {
     /// Adds to `sums` (per class of the ray's source) the unseen mass at
     /// step `t` on `parts` of ray `m` of source `ri` (`classes` its
     /// classes), whose part in the field of view is `[lo, hi]`: the seen
-    /// set's and the excluded looks' detections taken off.
-    #[allow(clippy::too_many_arguments)]
+    /// set's and the `excluded` looks' detections taken off. Without
+    /// `base`, only what the excluded looks take off, negated.
     #[inline]
     fn unseen_on_ray(
         &self,
         (ri, classes, m): (usize, std::ops::Range<usize>, usize),
-        (lo, hi): (f64, f64),
-        parts: &[(f64, f64)],
+        (lo, hi, parts): (f64, f64, &[(f64, f64)]),
         t: usize,
-        excluded: &[&Excluded<'_>],
+        (excluded, base): (&[&Excluded<'_>], bool),
         scratch: &mut Scratch,
         sums: &mut [f64; MAX_SPEED_CLASSES],
     ) {
@@ -443,6 +478,8 @@ impl ExactEstimator<'_> {
         segments.clear();
         if !pieces.is_empty() {
             detection_pieces(pieces, lo, hi, events, |u, v, q| segments.push((u, v, q)));
+        } else if !base {
+            return;
         }
         for (slot, c) in classes.enumerate() {
             let (class, hits) = (&self.classes[c], &self.seen[c]);
@@ -451,7 +488,9 @@ impl ExactEstimator<'_> {
                 |u: f64, v: f64| hits.detected_upto(m, v - lift) - hits.detected_upto(m, u - lift);
             let mut sum = 0.0;
             for &(p, q) in parts {
-                sum += (q - p) - seen(p, q);
+                if base {
+                    sum += (q - p) - seen(p, q);
+                }
                 for &(u, v, qx) in segments.iter() {
                     let (u, v) = (u.max(p), v.min(q));
                     if v > u {
