@@ -51,9 +51,21 @@ pub(super) struct RayHits {
     /// Aligned with `hits`: the detection probability of each interval.
     /// Empty when every look is certain (every interval's is 1).
     detected: Vec<f64>,
-    /// Aligned with `hits`, once [`RayHits::with_prefix`] built it: the
-    /// detected length of the ray's earlier intervals.
-    before: Vec<f64>,
+    /// Aligned with `hits`, once [`RayHits::with_prefix`] built them:
+    /// each interval's end, apart so that a search reads only them.
+    ends: Vec<f64>,
+    /// The same: each interval's start, the detected length of the ray's
+    /// earlier intervals and its detection probability, together so that
+    /// a search's answer is one read.
+    prefix: Vec<Prefix>,
+}
+
+/// One interval of a seen set as [`RayHits::detected_upto`] reads it.
+#[derive(Clone, Copy, Default)]
+struct Prefix {
+    start: f64,
+    before: f64,
+    detected: f64,
 }
 
 impl RayHits {
@@ -208,7 +220,8 @@ impl RayHits {
             offsets,
             hits,
             detected,
-            before: Vec::new(),
+            ends: Vec::new(),
+            prefix: Vec::new(),
         }
     }
 
@@ -326,7 +339,8 @@ impl RayHits {
             offsets,
             hits,
             detected: Vec::new(),
-            before: Vec::new(),
+            ends: Vec::new(),
+            prefix: Vec::new(),
         }
     }
 
@@ -340,7 +354,11 @@ impl RayHits {
 
     /// Heap bytes held.
     pub(super) fn memory_bytes(&self) -> usize {
-        self.offsets.capacity() * 4 + self.hits.capacity() * 16 + self.detected.capacity() * 8
+        self.offsets.capacity() * 4
+            + self.hits.capacity() * 16
+            + self.detected.capacity() * 8
+            + self.ends.capacity() * 8
+            + self.prefix.capacity() * std::mem::size_of::<Prefix>()
     }
 
     /// The union of two unions of certain looks on the same rays, `a`'s
@@ -485,7 +503,8 @@ impl RayHits {
             offsets,
             hits,
             detected,
-            before: Vec::new(),
+            ends: Vec::new(),
+            prefix: Vec::new(),
         }
     }
 
@@ -515,39 +534,42 @@ impl RayHits {
     /// The same seen sets with the prefix sums that
     /// [`RayHits::detected_upto`] reads.
     pub(super) fn with_prefix(mut self) -> Self {
-        let mut before = Vec::with_capacity(self.hits.len());
+        let mut prefix = Vec::with_capacity(self.hits.len());
         for m in 0..self.offsets.len().saturating_sub(1) {
             let mut acc = 0.0;
             for i in self.offsets[m] as usize..self.offsets[m + 1] as usize {
-                before.push(acc);
                 let (a, b) = self.hits[i];
-                acc += (b - a) * self.detected.get(i).copied().unwrap_or(1.0);
+                let detected = self.detected.get(i).copied().unwrap_or(1.0);
+                prefix.push(Prefix {
+                    start: a,
+                    before: acc,
+                    detected,
+                });
+                acc += (b - a) * detected;
             }
         }
-        self.before = before;
+        self.ends = self.hits.iter().map(|&(_, b)| b).collect();
+        self.prefix = prefix;
         self
     }
 
     /// `∫_{−∞}^{x} detected` along ray `m` as of step 0 (needs
-    /// [`RayHits::with_prefix`]): a binary search, so that a part of a ray
-    /// is measured without walking or sorting its pieces (a seen set of a
-    /// long history has dozens on a ray).
+    /// [`RayHits::with_prefix`]): a search of the ray's ends, so that a
+    /// part of a ray is measured without walking or sorting its pieces (a
+    /// seen set of a long history has dozens on a ray).
     #[inline]
     pub(super) fn detected_upto(&self, m: usize, x: f64) -> f64 {
         let (lo, hi) = (self.offsets[m] as usize, self.offsets[m + 1] as usize);
-        if lo == hi {
-            return 0.0;
-        }
-        let pieces = &self.hits[lo..hi];
+        let ends = &self.ends[lo..hi];
         // The first piece that ends after x.
-        let j = pieces.partition_point(|p| p.1 <= x);
-        let d = |i: usize| self.detected.get(i).copied().unwrap_or(1.0);
-        match pieces.get(j) {
-            Some(&(x0, _)) if x > x0 => self.before[lo + j] + (x - x0) * d(lo + j),
-            Some(_) => self.before[lo + j],
+        let j = ends.partition_point(|&e| e <= x);
+        match self.prefix[lo..hi].get(j) {
+            Some(p) if x > p.start => p.before + (x - p.start) * p.detected,
+            Some(p) => p.before,
+            None if j == 0 => 0.0,
             None => {
-                let (x0, x1) = pieces[hi - lo - 1];
-                self.before[hi - 1] + (x1 - x0) * d(hi - 1)
+                let p = self.prefix[hi - 1];
+                p.before + (ends[j - 1] - p.start) * p.detected
             }
         }
     }
