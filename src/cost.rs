@@ -60,7 +60,7 @@
 //! | general: cells × classes | 3.943e-4 | circles: a ray range per cell and class |
 //! | general: cells × rays × (1 + ov) | 1.351e-5 | its rays, with the overlapping looks |
 //! | general: cells × targets | 1.287e-6 | every reported target per cell |
-//! | sighted: cells × rays near obstacles | 2.000e-5 | a ground look's hidden part by its rays: cells × rays × the share of its reach whose squares meet an obstacle |
+//! | sighted: cells × rays near obstacles | 1.137e-5 | a ground look's hidden part by its rays: cells × rays × the share of its reach whose squares meet an obstacle |
 //! | paper: setup | 1.410e-5 | per sensor: `(2vT+1)²` overlaps, targets, 512 escape samples per source and class |
 //! | paper: cells × (seen + E) | 7.086e-7 | per cell: the sensor's targets and the excluded looks |
 //! | paper: cells × ov² | 9.092e-6 | the excluded area's cover |
@@ -109,7 +109,7 @@ pub const PLAN_MODEL: [(&str, f64); 19] = [
     ("general: cells × classes", 3.943e-4),
     ("general: cells × rays × (1 + ov)", 1.351e-5),
     ("general: cells × targets", 1.287e-6),
-    ("sighted: cells × rays near obstacles", 2.0e-5),
+    ("sighted: cells × rays near obstacles", 1.137e-5),
     ("paper: setup", 1.410e-5),
     ("paper: cells × (seen + E)", 7.086e-7),
     ("paper: cells × ov²", 9.092e-6),
