@@ -291,8 +291,6 @@ impl<'a> ExactEstimator<'a> {
         } else {
             Vec::new()
         };
-        // How far each sensor may move: none for an elevated one, which
-        // sees its whole square.
         let ground = if scenario.has_obstacles() {
             starts
                 .iter()
