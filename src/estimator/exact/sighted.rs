@@ -378,7 +378,6 @@ impl ExactEstimator<'_> {
     /// here. The seen set's part is the same in every search of a plan, so
     /// it is kept per cell and step; the excluded looks' part is taken off
     /// it.
-    #[allow(clippy::too_many_arguments)]
     fn unseen_hidden(
         &self,
         (sensor, k, look): (usize, Cell, &Look),
