@@ -381,6 +381,23 @@ impl ElementaryGrid {
         (self.xs.len() - 1, self.ys.len() - 1)
     }
 
+    /// The smallest block `[a0, a1) × [b0, b1)` of rectangles that covers
+    /// the part of `r` inside the grid (at least one rectangle).
+    pub fn covering(&self, r: &Rect) -> (usize, usize, usize, usize) {
+        let span = |edges: &[f64], lo: f64, hi: f64| {
+            let n = edges.len() - 1;
+            let a0 = edges
+                .partition_point(|&e| e <= lo)
+                .saturating_sub(1)
+                .min(n - 1);
+            let a1 = edges.partition_point(|&e| e < hi).clamp(a0 + 1, n);
+            (a0, a1)
+        };
+        let (a0, a1) = span(&self.xs, r.x0, r.x1);
+        let (b0, b1) = span(&self.ys, r.y0, r.y1);
+        (a0, a1, b0, b1)
+    }
+
     /// The block `[a0, a1) × [b0, b1)` of rectangles that makes up `F_k`
     /// for the field of view `fov_slot` (an index into the scenario's
     /// `fovs`; 0 is the type `default`'s).

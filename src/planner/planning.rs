@@ -428,13 +428,13 @@ impl Planner {
                     );
                     cancel.check()?;
                     est.prepare_carried(carry);
-                    Chosen::Exact(est)
+                    Chosen::Exact(Box::new(est))
                 }
                 None => {
                     let est = self.exact_estimator(input, None);
                     cancel.check()?;
                     est.prepare();
-                    Chosen::Exact(est)
+                    Chosen::Exact(Box::new(est))
                 }
             },
         })
@@ -508,7 +508,8 @@ impl Planner {
 /// The estimator a plan asked for.
 pub(crate) enum Chosen<'p> {
     Paper(PaperEstimator<'p>),
-    Exact(ExactEstimator<'p>),
+    /// Boxed: an exact estimator holds several plan-long caches.
+    Exact(Box<ExactEstimator<'p>>),
 }
 
 impl Chosen<'_> {
@@ -516,7 +517,7 @@ impl Chosen<'_> {
     pub(crate) fn as_dyn(&self) -> &dyn Estimator {
         match self {
             Chosen::Paper(est) => est,
-            Chosen::Exact(est) => est,
+            Chosen::Exact(est) => &**est,
         }
     }
 

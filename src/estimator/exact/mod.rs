@@ -100,6 +100,9 @@ pub struct ExactEstimator<'a> {
     /// With obstacles, per sensor, what the plan keeps of its looks over
     /// its reach.
     ground: Vec<cell_sights::GroundReach>,
+    /// With obstacles, what each group of overlapping excluded looks that
+    /// obstacles cut detects, kept for the plan's fills.
+    cut_detections: sighted::CutDetections,
     /// With obstacles, the scenario's index of what ground looks cannot
     /// see, when it has one (read before `ground`'s caches).
     sight_index: Option<&'a SightIndex>,
@@ -324,6 +327,7 @@ impl<'a> ExactEstimator<'a> {
             known,
             flights,
             ground,
+            cut_detections: sighted::CutDetections::default(),
             sight_index,
             classes,
             seen,

@@ -30,6 +30,9 @@
 //! the rays it does not see are read from the scenario's `sight_index`
 //! when it has one.
 
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+
 use super::ExactEstimator;
 use super::cell_sights::{CellSight, cell_sight};
 use super::sight_index::{CellView, hidden_parts};
@@ -508,6 +511,12 @@ impl ExactEstimator<'_> {
     /// that see a point. The excluded looks that see whole squares mask
     /// whole rectangles afterwards ([`Window::block_sums`]), which makes
     /// the product over all of them.
+    ///
+    /// The cut looks fall into groups whose fields of view overlap (linked
+    /// through each other). No point lies in two groups, so what they take
+    /// off adds up, and what each group detects is kept for the plan
+    /// ([`CutDetections`]): the fills of every sensor exclude the same
+    /// looks (the certificate's, all of them), in each search.
     fn less_what_cut_looks_detect(
         &self,
         grid: &ElementaryGrid,
@@ -516,7 +525,85 @@ impl ExactEstimator<'_> {
         cut: &[&Excluded<'_>],
         scratch: &mut Scratch,
     ) {
-        let block: Block = (win.a0, win.a0 + win.na, win.b0, win.b0 + win.nb);
+        // Groups of looks whose fields of view overlap (linked through
+        // each other): the groups' detections add up.
+        let mut group: Vec<usize> = (0..cut.len()).collect();
+        for i in 0..cut.len() {
+            for j in 0..i {
+                if cut[i].0.region.may_overlap(&cut[j].0.region) {
+                    let (gi, gj) = (group[i], group[j]);
+                    group.iter_mut().filter(|g| **g == gi).for_each(|g| *g = gj);
+                }
+            }
+        }
+        let mut members = Vec::with_capacity(cut.len());
+        for (i, &g) in group.iter().enumerate() {
+            if group[..i].contains(&g) {
+                continue;
+            }
+            members.clear();
+            members.extend(
+                cut.iter()
+                    .zip(&group)
+                    .filter(|(_, h)| **h == g)
+                    .map(|(x, _)| *x),
+            );
+            self.cut_detection(grid, &members, t, scratch)
+                .take_from(win);
+        }
+    }
+
+    /// What the cut looks `group` detect at step `t` of each rectangle of
+    /// the block around their fields of view: from the plan's memo, or
+    /// worked out and kept there.
+    fn cut_detection(
+        &self,
+        grid: &ElementaryGrid,
+        group: &[&Excluded<'_>],
+        t: usize,
+        scratch: &mut Scratch,
+    ) -> Arc<CutDetection> {
+        // Sorted by key, so that the same group sums in the same order
+        // whichever fill asks first.
+        let mut group: Vec<_> = group
+            .iter()
+            .map(|&x| (CutDetections::look_key(x.0), x))
+            .collect();
+        group.sort_unstable_by_key(|(k, _)| *k);
+        let key = (group.iter().map(|(k, _)| *k).collect(), t);
+        if let Some(kept) = self.cut_detections.get(&key) {
+            return kept;
+        }
+        let group: Vec<&Excluded<'_>> = group.into_iter().map(|(_, x)| x).collect();
+        let group = &group[..];
+        let mut hull = group[0].0.region.rect;
+        for (x, _) in group {
+            hull = hull.hull(&x.region.rect);
+        }
+        let block = grid.covering(&hull);
+        let (a0, a1, b0, _) = block;
+        let na = a1 - a0;
+        let mut detected = vec![0.0; na * (block.3 - b0)];
+        self.detect_on_rays(grid, block, t, group, scratch, |a, b, d| {
+            detected[(b - b0) * na + (a - a0)] += d;
+        });
+        self.cut_detections
+            .keep(key, CutDetection { block, detected })
+    }
+
+    /// Calls `f(a, b, detected)` for each rectangle `(a, b)` of `block`
+    /// and each part of a ray in it that the looks `cut` see at step `t`:
+    /// the unseen mass there times the chance that some look of `cut`
+    /// detects it (see [`ExactEstimator::less_what_cut_looks_detect`]).
+    fn detect_on_rays(
+        &self,
+        grid: &ElementaryGrid,
+        block: Block,
+        t: usize,
+        cut: &[&Excluded<'_>],
+        scratch: &mut Scratch,
+        mut f: impl FnMut(usize, usize, f64),
+    ) {
         let rect = crate::geometry::Rect {
             x0: grid.xs[block.0],
             x1: grid.xs[block.1],
@@ -544,8 +631,6 @@ impl ExactEstimator<'_> {
             events,
             ..
         } = scratch;
-        let (a0, b0, na) = (win.a0, win.b0, win.na);
-        let unseen = win.unseen_mut();
         for (ri, classes) in self.sources() {
             let sr = &self.rays[ri];
             let o = sr.source.pos;
@@ -588,10 +673,84 @@ impl ExactEstimator<'_> {
                             detected += class.weight * ((to - from) - (end - upto[slot]));
                             upto[slot] = end;
                         }
-                        unseen[(b - b0) * na + (a - a0)] -= q * detected;
+                        f(a, b, q * detected);
                     });
                 }
             }
         }
+    }
+}
+
+/// What a group of cut looks detects at one step of each rectangle of the
+/// block around their fields of view.
+pub(super) struct CutDetection {
+    block: Block,
+    /// Row by row over `block`.
+    detected: Vec<f64>,
+}
+
+impl CutDetection {
+    /// Takes what the group detects off each rectangle of `win` it shares.
+    fn take_from(&self, win: &mut Window) {
+        let (a0, a1, b0, b1) = self.block;
+        let (wa0, wb0, wna) = (win.a0, win.b0, win.na);
+        let (lo_a, hi_a) = (a0.max(wa0), a1.min(wa0 + wna));
+        let (lo_b, hi_b) = (b0.max(wb0), b1.min(wb0 + win.nb));
+        if lo_a >= hi_a {
+            return;
+        }
+        let unseen = win.unseen_mut();
+        for b in lo_b..hi_b {
+            let mine = &self.detected[(b - b0) * (a1 - a0)..][lo_a - a0..hi_a - a0];
+            let theirs = &mut unseen[(b - wb0) * wna..][lo_a - wa0..hi_a - wa0];
+            for (u, d) in theirs.iter_mut().zip(mine) {
+                *u -= d;
+            }
+        }
+    }
+}
+
+/// A plan's [`CutDetection`]s, by group of looks and step: each is asked
+/// for by the fills of every sensor whose reach the group meets.
+#[derive(Default)]
+pub(super) struct CutDetections(Mutex<HashMap<CutKey, Arc<CutDetection>>>);
+
+/// The looks of a group (each its field of view, detection probability
+/// and viewpoint, by their bits, sorted) and a step.
+type CutKey = (Vec<[u64; 10]>, usize);
+
+impl CutDetections {
+    /// A look's field of view, detection probability and viewpoint, by
+    /// their bits.
+    fn look_key(look: &Look) -> [u64; 10] {
+        let nan = Point::new(f64::NAN, f64::NAN);
+        let r = &look.region.rect;
+        let from = look.from.unwrap_or(nan);
+        let (c, radius) = look.region.disk.map_or((nan, f64::NAN), |d| (d.c, d.r));
+        [
+            r.x0,
+            r.x1,
+            r.y0,
+            r.y1,
+            c.x,
+            c.y,
+            radius,
+            look.p_detect,
+            from.x,
+            from.y,
+        ]
+        .map(f64::to_bits)
+    }
+
+    fn get(&self, key: &CutKey) -> Option<Arc<CutDetection>> {
+        let kept = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        kept.get(key).cloned()
+    }
+
+    /// Keeps `value` under `key` unless another thread kept one first, and
+    /// returns what is kept.
+    fn keep(&self, key: CutKey, value: CutDetection) -> Arc<CutDetection> {
+        let mut kept = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        Arc::clone(kept.entry(key).or_insert_with(|| Arc::new(value)))
     }
 }
