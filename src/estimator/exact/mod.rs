@@ -243,19 +243,25 @@ impl<'a> ExactEstimator<'a> {
         } else {
             Vec::new()
         };
-        classes
+        // A source's classes are consecutive and share its rays: their
+        // seen sets are made together.
+        let sources: Vec<&[ClassRays]> = classes.chunk_by(|a, b| a.rays == b.rays).collect();
+        let by_source: Vec<Vec<RayHits>> = sources
             .par_iter()
             .with_min_len(crate::parallel::min_len())
-            .map(|c| {
-                let hits = RayHits::new(&rays[c.rays], observed, &keys, &sights, c.speed);
+            .map(|cs| {
+                let speeds: Vec<f64> = cs.iter().map(|c| c.speed).collect();
+                let hits =
+                    RayHits::for_classes(&rays[cs[0].rays], observed, &keys, &sights, &speeds);
                 // The sighted path measures parts of rays by prefix sums.
                 if scenario.has_obstacles() {
-                    hits.with_prefix()
+                    hits.into_iter().map(RayHits::with_prefix).collect()
                 } else {
                     hits
                 }
             })
-            .collect()
+            .collect();
+        by_source.into_iter().flatten().collect()
     }
 
     /// The estimator of `now` with its classes' seen sets.

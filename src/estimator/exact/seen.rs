@@ -13,8 +13,19 @@ use crate::geometry::OpenIntervals;
 use crate::obstacle::Sight;
 use crate::scenario::{Look, all_certain};
 
-/// A look's interval on a ray: `(ray, from, to, p_detect)`.
-type RayPiece = (u32, f64, f64, f64);
+/// A look's interval on a ray, not yet pushed: its ray, the step `s` of
+/// the look (pushed by `v·s`), the start of the look's whole interval on
+/// the ray (which decides whether it starts past the ray's exit), the
+/// interval and the look's `p_detect`.
+#[derive(Clone, Copy)]
+struct RayPiece {
+    m: u32,
+    s: u32,
+    gate: f64,
+    from: f64,
+    to: f64,
+    p_detect: f64,
+}
 
 thread_local! {
     /// [`RayHits::weighted`]'s pieces and their sorted copy, kept across
@@ -83,10 +94,27 @@ impl RayHits {
         sights: &[Vec<Option<Sight>>],
         speed: f64,
     ) -> Self {
+        let mut one = Self::for_classes(sr, observed, keys, sights, &[speed]);
+        one.pop().unwrap_or_default()
+    }
+
+    /// [`RayHits::new`] for each of the classes of `speeds` on the rays
+    /// `sr`: with uncertain looks or obstacles, the looks' intervals on the
+    /// rays are found once for all of them.
+    pub(super) fn for_classes(
+        sr: &SourceRays,
+        observed: &[Vec<Look>],
+        keys: &[Vec<Option<LookKey>>],
+        sights: &[Vec<Option<Sight>>],
+        speeds: &[f64],
+    ) -> Vec<Self> {
         if sights.is_empty() && observed.iter().all(|step| all_certain(step)) {
-            Self::union(sr, observed, keys, speed)
+            speeds
+                .iter()
+                .map(|&speed| Self::union(sr, observed, keys, speed))
+                .collect()
         } else {
-            Self::weighted(sr, observed, keys, sights, speed)
+            Self::weighted(sr, observed, keys, sights, speeds)
         }
     }
 
@@ -94,17 +122,24 @@ impl RayHits {
     /// crosses (read from the index when the look is indexed), then per
     /// ray a sweep that cuts them into disjoint pieces with their detection
     /// probability. As in a union, the intervals that start past the ray's
-    /// exit are left out: no use of a seen set looks there.
+    /// exit are left out: no use of a seen set looks there. The intervals
+    /// are found and sorted by ray once; each class of `speeds` pushes
+    /// them by its own distances.
     fn weighted(
         sr: &SourceRays,
         observed: &[Vec<Look>],
         keys: &[Vec<Option<LookKey>>],
         sights: &[Vec<Option<Sight>>],
-        speed: f64,
-    ) -> Self {
+        speeds: &[f64],
+    ) -> Vec<Self> {
         WEIGHTED_SCRATCH.with_borrow_mut(|(pieces, sorted)| {
             pieces.clear();
-            let hits = Self::weighted_in(sr, observed, keys, sights, speed, pieces, sorted);
+            Self::weighted_pieces(sr, observed, keys, sights, speeds, pieces);
+            Self::by_ray(sr.dirs.len(), pieces, sorted);
+            let hits = speeds
+                .iter()
+                .map(|&speed| Self::weighted_sweep(sr, sorted, speed))
+                .collect();
             // A scratch grown past the cap is not kept.
             if pieces.capacity() > MAX_KEPT_PIECES {
                 *pieces = Vec::new();
@@ -114,34 +149,41 @@ impl RayHits {
         })
     }
 
-    /// [`RayHits::weighted`] with scratch space for the pieces (empty) and
-    /// for them sorted by ray.
-    fn weighted_in(
+    /// Pushes onto `pieces` every look's intervals on the rays `sr`, not
+    /// yet pushed by the targets' flight (see [`RayPiece`]).
+    fn weighted_pieces(
         sr: &SourceRays,
         observed: &[Vec<Look>],
         keys: &[Vec<Option<LookKey>>],
         sights: &[Vec<Option<Sight>>],
-        speed: f64,
+        speeds: &[f64],
         pieces: &mut Vec<RayPiece>,
-        sorted: &mut Vec<RayPiece>,
-    ) -> Self {
+    ) {
         let mut buf = Vec::new();
         let mut visible = Vec::new();
         let o = sr.source.pos;
-        let n = sr.dirs.len();
+        let slowest = speeds.iter().copied().fold(f64::INFINITY, f64::min);
         for (s, looks) in observed.iter().enumerate() {
-            let shift = speed * s as f64;
+            // Every class's pieces start past the exit when the slowest's do.
+            let least_shift = slowest * s as f64;
+            let step = s as u32;
             for (i, look) in looks.iter().enumerate() {
                 let key = keys.get(s).and_then(|k| k.get(i).copied().flatten());
                 if let (Some(key), Some(table)) = (key, &sr.looks) {
-                    if table.past_exit(key, shift) {
+                    if table.past_exit(key, least_shift) {
                         continue;
                     }
                     let (a, stored) = table.of(key);
-                    let rays = (a..).zip(stored.iter().zip(&sr.beyond[a..a + stored.len()]));
-                    for (m, (&(p, q), &far)) in rays {
-                        if p <= q && p + shift <= far {
-                            pieces.push((m as u32, p + shift, q + shift, look.p_detect));
+                    for (m, &(p, q)) in (a..).zip(stored) {
+                        if p <= q {
+                            pieces.push(RayPiece {
+                                m: m as u32,
+                                s: step,
+                                gate: p,
+                                from: p,
+                                to: q,
+                                p_detect: look.p_detect,
+                            });
                         }
                     }
                     continue;
@@ -155,40 +197,56 @@ impl RayHits {
                     .and_then(Option::as_ref);
                 for m in a..b {
                     let (d, inv) = sr.dirs[m];
-                    if let Some((p, q)) = look.region.ray(o, d, inv)
-                        && p + shift <= sr.beyond[m]
-                    {
-                        let Some(sight) = sight else {
-                            pieces.push((m as u32, p + shift, q + shift, look.p_detect));
-                            continue;
-                        };
-                        visible.clear();
-                        sight.visible(o, d, p, q, &mut visible);
-                        pieces.extend(
-                            visible
-                                .iter()
-                                .map(|&(p, q)| (m as u32, p + shift, q + shift, look.p_detect)),
-                        );
+                    let Some((p, q)) = look.region.ray(o, d, inv) else {
+                        continue;
+                    };
+                    if p + least_shift > sr.beyond[m] {
+                        continue;
                     }
+                    let piece = |from: f64, to: f64| RayPiece {
+                        m: m as u32,
+                        s: step,
+                        gate: p,
+                        from,
+                        to,
+                        p_detect: look.p_detect,
+                    };
+                    let Some(sight) = sight else {
+                        pieces.push(piece(p, q));
+                        continue;
+                    };
+                    visible.clear();
+                    sight.visible(o, d, p, q, &mut visible);
+                    pieces.extend(visible.iter().map(|&(p, q)| piece(p, q)));
                 }
             }
         }
-        // By ray: a counting sort (the pieces of one ray keep their order).
+    }
+
+    /// Copies `pieces` into `sorted` by ray, a counting sort (the pieces
+    /// of one ray keep their order), of `n` rays.
+    fn by_ray(n: usize, pieces: &[RayPiece], sorted: &mut Vec<RayPiece>) {
         let mut counts = vec![0usize; n + 1];
-        for &(m, ..) in pieces.iter() {
-            counts[m as usize + 1] += 1;
+        for piece in pieces {
+            counts[piece.m as usize + 1] += 1;
         }
         for m in 0..n {
             counts[m + 1] += counts[m];
         }
         sorted.clear();
-        sorted.resize(pieces.len(), (0u32, 0.0, 0.0, 0.0));
-        for &piece in pieces.iter() {
-            let slot = &mut counts[piece.0 as usize];
+        sorted.extend_from_slice(pieces);
+        for &piece in pieces {
+            let slot = &mut counts[piece.m as usize];
             sorted[*slot] = piece;
             *slot += 1;
         }
-        let pieces = sorted;
+    }
+
+    /// The seen sets of a class of speed `speed` from the pieces of every
+    /// look, sorted by ray: each pushed by `speed·s`, left out when its
+    /// look's interval then starts past the ray's exit.
+    fn weighted_sweep(sr: &SourceRays, pieces: &[RayPiece], speed: f64) -> Self {
+        let n = sr.dirs.len();
         let mut offsets = vec![0u32; n + 1];
         let mut hits: Vec<(f64, f64)> = Vec::new();
         let mut detected: Vec<f64> = Vec::new();
@@ -196,24 +254,26 @@ impl RayHits {
         let mut i = 0;
         for m in 0..n {
             let start = i;
-            while i < pieces.len() && pieces[i].0 as usize == m {
+            while i < pieces.len() && pieces[i].m as usize == m {
                 i += 1;
             }
             let first = hits.len();
-            sweep.run(
-                pieces[start..i].iter().map(|&(_, p, q, pd)| (p, q, pd)),
-                |a, b, seen| {
-                    // A piece that continues the last one of this ray at
-                    // the same probability extends it.
-                    match (hits[first..].last_mut(), detected.last()) {
-                        (Some(last), Some(&d)) if last.1 == a && d == seen => last.1 = b,
-                        _ => {
-                            hits.push((a, b));
-                            detected.push(seen);
-                        }
+            let far = sr.beyond.get(m).copied().unwrap_or(f64::INFINITY);
+            let pushed = pieces[start..i].iter().filter_map(|x| {
+                let shift = speed * f64::from(x.s);
+                (x.gate + shift <= far).then_some((x.from + shift, x.to + shift, x.p_detect))
+            });
+            sweep.run(pushed, |a, b, seen| {
+                // A piece that continues the last one of this ray at the
+                // same probability extends it.
+                match (hits[first..].last_mut(), detected.last()) {
+                    (Some(last), Some(&d)) if last.1 == a && d == seen => last.1 = b,
+                    _ => {
+                        hits.push((a, b));
+                        detected.push(seen);
                     }
-                },
-            );
+                }
+            });
             offsets[m + 1] = hits.len() as u32;
         }
         RayHits {

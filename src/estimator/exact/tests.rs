@@ -225,6 +225,84 @@ fn indexed_looks_give_the_computed_seen_sets() {
     assert!(compared > 4_000, "{compared}");
 }
 
+/// A source's classes make their seen sets together (the looks' intervals
+/// found once, each class pushing them by its own distances) exactly as
+/// each class alone would: every built-in with speed mixtures, indexed
+/// looks (`site-gates`) and looks that obstacles cut (`site-campus`), a
+/// history long enough to push intervals past the rays' exits.
+#[test]
+fn a_sources_classes_see_together_what_each_sees_alone() {
+    let mut compared = 0;
+    for s in builtins() {
+        let mut rays = SourceRays::for_scenario(&s);
+        SourceRays::index_looks(&mut rays, &s);
+        let free = |ty: usize, c: Cell| s.on_lattice(c) && s.is_free(ty, c);
+        let observed: Vec<Vec<Look>> = (0..24)
+            .map(|step: i32| {
+                (0..8)
+                    .filter_map(|i: i32| {
+                        let ty = i as usize % s.types.len();
+                        let c = Cell {
+                            col: (i * 7 + step * 3).rem_euclid(s.cols),
+                            row: (i * 5 + step * 2).rem_euclid(s.rows),
+                        };
+                        free(ty, c).then(|| s.look(ty, c))
+                    })
+                    .collect()
+            })
+            .collect();
+        let keys: Vec<Vec<_>> = if s.has_obstacles() {
+            Vec::new()
+        } else {
+            observed
+                .iter()
+                .map(|step| step.iter().map(|l| look_key(&s, &l.region)).collect())
+                .collect()
+        };
+        let sights: Vec<Vec<_>> = if s.has_obstacles() {
+            observed
+                .iter()
+                .map(|step| step.iter().map(|l| s.sight(l)).collect())
+                .collect()
+        } else {
+            Vec::new()
+        };
+        for sr in &rays {
+            let speeds: Vec<f64> = s
+                .classes_of(sr.source_index)
+                .iter()
+                .map(|c| c.speed)
+                .collect();
+            let together = RayHits::for_classes(sr, &observed, &keys, &sights, &speeds);
+            assert_eq!(together.len(), speeds.len());
+            for (hits, &speed) in together.iter().zip(&speeds) {
+                let alone = RayHits::for_classes(sr, &observed, &keys, &sights, &[speed]);
+                let bits = |h: &RayHits| -> Vec<(u64, u64)> {
+                    h.hits
+                        .iter()
+                        .map(|&(p, q)| (p.to_bits(), q.to_bits()))
+                        .collect()
+                };
+                assert_eq!(hits.offsets, alone[0].offsets, "{}", s.id);
+                assert_eq!(bits(hits), bits(&alone[0]), "{}", s.id);
+                for m in 0..sr.dirs.len() {
+                    let detected = |h: &RayHits| {
+                        h.detected(m)
+                            .iter()
+                            .map(|d| d.to_bits())
+                            .collect::<Vec<_>>()
+                    };
+                    assert_eq!(detected(hits), detected(&alone[0]), "{} ray {m}", s.id);
+                }
+                if speeds.len() > 1 {
+                    compared += hits.hits.len();
+                }
+            }
+        }
+    }
+    assert!(compared > 1_000, "{compared}");
+}
+
 /// The seen sets' sweep of weighted intervals gives the pieces of
 /// `detection_pieces`: the same ends, the same probabilities to rounding,
 /// on random intervals that share ends and overlap in many ways.
