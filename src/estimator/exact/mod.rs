@@ -102,7 +102,7 @@ pub struct ExactEstimator<'a> {
     ground: Vec<cell_sights::GroundReach>,
     /// With obstacles, what each group of overlapping excluded looks that
     /// obstacles cut detects, kept for the plan's fills.
-    cut_detections: sighted::CutDetections,
+    cut_detections: cell_sights::CutDetections,
     /// With obstacles, the scenario's index of what ground looks cannot
     /// see, when it has one (read before `ground`'s caches).
     sight_index: Option<&'a SightIndex>,
@@ -333,7 +333,7 @@ impl<'a> ExactEstimator<'a> {
             known,
             flights,
             ground,
-            cut_detections: sighted::CutDetections::default(),
+            cut_detections: cell_sights::CutDetections::default(),
             sight_index,
             classes,
             seen,

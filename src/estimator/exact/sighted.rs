@@ -30,11 +30,10 @@
 //! the rays it does not see are read from the scenario's `sight_index`
 //! when it has one.
 
-use std::collections::HashMap;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use super::ExactEstimator;
-use super::cell_sights::{CellSight, cell_sight};
+use super::cell_sights::{CellSight, CutDetection, CutDetections, cell_sight};
 use super::sight_index::{CellView, hidden_parts};
 use super::windows::{BlockSums, Window};
 use crate::estimator::elementary::{Block, ElementaryGrid, Segment, trace};
@@ -588,7 +587,7 @@ impl ExactEstimator<'_> {
             detected[(b - b0) * na + (a - a0)] += d;
         });
         self.cut_detections
-            .keep(key, CutDetection { block, detected })
+            .keep(key, CutDetection::new(block, detected))
     }
 
     /// Calls `f(a, b, detected)` for each rectangle `(a, b)` of `block`
@@ -678,79 +677,5 @@ impl ExactEstimator<'_> {
                 }
             }
         }
-    }
-}
-
-/// What a group of cut looks detects at one step of each rectangle of the
-/// block around their fields of view.
-pub(super) struct CutDetection {
-    block: Block,
-    /// Row by row over `block`.
-    detected: Vec<f64>,
-}
-
-impl CutDetection {
-    /// Takes what the group detects off each rectangle of `win` it shares.
-    fn take_from(&self, win: &mut Window) {
-        let (a0, a1, b0, b1) = self.block;
-        let (wa0, wb0, wna) = (win.a0, win.b0, win.na);
-        let (lo_a, hi_a) = (a0.max(wa0), a1.min(wa0 + wna));
-        let (lo_b, hi_b) = (b0.max(wb0), b1.min(wb0 + win.nb));
-        if lo_a >= hi_a {
-            return;
-        }
-        let unseen = win.unseen_mut();
-        for b in lo_b..hi_b {
-            let mine = &self.detected[(b - b0) * (a1 - a0)..][lo_a - a0..hi_a - a0];
-            let theirs = &mut unseen[(b - wb0) * wna..][lo_a - wa0..hi_a - wa0];
-            for (u, d) in theirs.iter_mut().zip(mine) {
-                *u -= d;
-            }
-        }
-    }
-}
-
-/// A plan's [`CutDetection`]s, by group of looks and step: each is asked
-/// for by the fills of every sensor whose reach the group meets.
-#[derive(Default)]
-pub(super) struct CutDetections(Mutex<HashMap<CutKey, Arc<CutDetection>>>);
-
-/// The looks of a group (each its field of view, detection probability
-/// and viewpoint, by their bits, sorted) and a step.
-type CutKey = (Vec<[u64; 10]>, usize);
-
-impl CutDetections {
-    /// A look's field of view, detection probability and viewpoint, by
-    /// their bits.
-    fn look_key(look: &Look) -> [u64; 10] {
-        let nan = Point::new(f64::NAN, f64::NAN);
-        let r = &look.region.rect;
-        let from = look.from.unwrap_or(nan);
-        let (c, radius) = look.region.disk.map_or((nan, f64::NAN), |d| (d.c, d.r));
-        [
-            r.x0,
-            r.x1,
-            r.y0,
-            r.y1,
-            c.x,
-            c.y,
-            radius,
-            look.p_detect,
-            from.x,
-            from.y,
-        ]
-        .map(f64::to_bits)
-    }
-
-    fn get(&self, key: &CutKey) -> Option<Arc<CutDetection>> {
-        let kept = self.0.lock().unwrap_or_else(|e| e.into_inner());
-        kept.get(key).cloned()
-    }
-
-    /// Keeps `value` under `key` unless another thread kept one first, and
-    /// returns what is kept.
-    fn keep(&self, key: CutKey, value: CutDetection) -> Arc<CutDetection> {
-        let mut kept = self.0.lock().unwrap_or_else(|e| e.into_inner());
-        Arc::clone(kept.entry(key).or_insert_with(|| Arc::new(value)))
     }
 }
