@@ -25,7 +25,7 @@
 
 use super::ExactEstimator;
 use std::cell::RefCell;
-use std::sync::OnceLock;
+use std::sync::{Arc, Mutex, OnceLock};
 
 use crate::geometry::{Point, detection_pieces, detection_within};
 use crate::limits::MAX_HORIZON;
@@ -127,6 +127,19 @@ pub struct FirstDetections<'e> {
     history: Profile,
     /// Per sensor, its stops (see [`FirstDetections::stops`]).
     stops: Vec<OnceLock<Stops>>,
+    /// The last background built from sensors' paths, with those paths
+    /// and sensors: the certificate searches every sensor against the
+    /// same paths of all of them.
+    last_among: Mutex<Option<Among>>,
+}
+
+/// A background of some sensors' paths (see
+/// [`FirstDetections::path_cover_among`]), and what it was built from.
+struct Among {
+    sensors: Vec<usize>,
+    paths: Vec<Vec<Cell>>,
+    horizon: usize,
+    background: Arc<Background>,
 }
 
 impl<'e> FirstDetections<'e> {
@@ -167,6 +180,7 @@ impl<'e> FirstDetections<'e> {
             classes_of_rays,
             history,
             stops: (0..est.types.len()).map(|_| OnceLock::new()).collect(),
+            last_among: Mutex::new(None),
         }
     }
 
@@ -425,7 +439,7 @@ impl<'e> FirstDetections<'e> {
         grid: &mut ValueGrid,
     ) -> PathCover<'_> {
         let stops = self.stops(sensor, start, grid);
-        self.cover(stops, self.background(self.pieces_of(extra)), grid)
+        self.cover(stops, &self.background(self.pieces_of(extra)), grid)
     }
 
     /// [`FirstDetections::path_cover`] against the looks of `sensors` on
@@ -439,8 +453,46 @@ impl<'e> FirstDetections<'e> {
         grid: &mut ValueGrid,
     ) -> PathCover<'_> {
         let stops = self.stops(sensor, start, grid);
-        let pieces = self.pieces_on(paths, sensors, grid.horizon());
-        self.cover(stops, self.background(pieces), grid)
+        let background = self.background_among(paths, sensors, grid.horizon());
+        self.cover(stops, &background, grid)
+    }
+
+    /// The background of the looks of `sensors` on `paths` over `horizon`
+    /// steps: the last one built, when it was built from the same paths of
+    /// the same sensors (the certificate asks for one per sensor), or a
+    /// new one, kept in its place.
+    fn background_among(
+        &self,
+        paths: &[&[Cell]],
+        sensors: &[usize],
+        horizon: usize,
+    ) -> Arc<Background> {
+        let same = |among: &Among| {
+            among.horizon == horizon
+                && among.sensors == sensors
+                && sensors
+                    .iter()
+                    .zip(&among.paths)
+                    .all(|(&q, path)| paths[q][..horizon] == path[..])
+        };
+        let lock = || self.last_among.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(among) = lock().as_ref().filter(|among| same(among)) {
+            return Arc::clone(&among.background);
+        }
+        // Built outside the lock: parallel searches against other sensors
+        // (best-response rounds) build their own at the same time.
+        let pieces = self.pieces_on(paths, sensors, horizon);
+        let background = Arc::new(self.background(pieces));
+        *lock() = Some(Among {
+            sensors: sensors.to_vec(),
+            paths: sensors
+                .iter()
+                .map(|&q| paths[q][..horizon].to_vec())
+                .collect(),
+            horizon,
+            background: Arc::clone(&background),
+        });
+        background
     }
 
     /// The gains of `stops` over `background`; `grid`'s values become each
@@ -448,7 +500,7 @@ impl<'e> FirstDetections<'e> {
     fn cover<'s>(
         &'s self,
         stops: &'s Stops,
-        background: Background,
+        background: &Background,
         grid: &mut ValueGrid,
     ) -> PathCover<'s> {
         // Which keys the extra looks touch: their ends move; the others'
