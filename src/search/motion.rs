@@ -130,6 +130,19 @@ impl Motion {
         let disps = step_displacements(speed);
         let mut first = vec![NEVER; n];
         let mut steps = vec![0u64; n];
+        // Each row's free offsets as bits, shifted up by m so that the
+        // window of a column c is the row's bits c..c+2m (side ≤ 2·3·12+1
+        // fits in 128 bits with the shift).
+        let rows: Vec<u128> = free
+            .chunks(side)
+            .map(|row| {
+                row.iter()
+                    .enumerate()
+                    .filter(|&(_, &f)| f)
+                    .fold(0u128, |bits, (c, _)| bits | 1 << (c + speed))
+            })
+            .collect();
+        let row_bits = (1u128 << w) - 1;
         first[start] = 0;
         let mut frontier = vec![start];
         for t in 1..=horizon {
@@ -139,14 +152,9 @@ impl Motion {
                 // The free cells of the window around o.
                 let mut win = 0u64;
                 for dr in -m..=m {
-                    for dc in -m..=m {
-                        let (rr, cc) = (r + dr, c + dc);
-                        if (0..side as i32).contains(&rr)
-                            && (0..side as i32).contains(&cc)
-                            && free[rr as usize * side + cc as usize]
-                        {
-                            win |= 1 << ((dr + m) as u32 * w + (dc + m) as u32);
-                        }
+                    if let Some(row) = rows.get((r + dr) as usize) {
+                        let bits = (row >> c) & row_bits;
+                        win |= (bits as u64) << ((dr + m) as u32 * w);
                     }
                 }
                 // Breadth-first search to depth m, as m dilations.
@@ -155,13 +163,17 @@ impl Motion {
                     reach = dilate(reach, w) & win;
                 }
                 steps[o] = reach;
-                for &(dc, dr) in disps {
-                    if reach >> ((dr + m) as u32 * w + (dc + m) as u32) & 1 == 1 {
-                        let o2 = ((r + dr) * side as i32 + c + dc) as usize;
-                        if first[o2] == NEVER {
-                            first[o2] = t as u32;
-                            next.push(o2);
-                        }
+                // Every reachable cell, in bit order (the frontier's order
+                // does not change what it reaches, nor when).
+                let mut bits = reach;
+                while bits != 0 {
+                    let bit = bits.trailing_zeros();
+                    bits &= bits - 1;
+                    let (dr, dc) = ((bit / w) as i32 - m, (bit % w) as i32 - m);
+                    let o2 = ((r + dr) * side as i32 + c + dc) as usize;
+                    if first[o2] == NEVER {
+                        first[o2] = t as u32;
+                        next.push(o2);
                     }
                 }
             }

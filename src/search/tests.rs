@@ -180,6 +180,40 @@ proptest! {
     }
 }
 
+/// The largest square of offsets (fastest sensor, longest horizon) is
+/// wider than a machine word: reachability still matches the tests' own
+/// breadth-first search at every step, near every edge.
+#[test]
+fn reachability_holds_on_the_largest_square() {
+    use crate::limits::MAX_HORIZON;
+    let (speed, horizon) = (MAX_SENSOR_SPEED, MAX_HORIZON);
+    let e = (speed * horizon) as i32;
+    // A scatter of blocked cells (about one in eight) and a wall down one
+    // column, with a gap.
+    let cells: Vec<u8> = (0..997u64).map(|i| (i * i * 7919 % 97) as u8).collect();
+    let scatter = mask(speed, horizon, &cells, 12);
+    let free = move |dc: i32, dr: i32| scatter(dc, dr) && !(dc == e - 5 && dr != 3);
+    let g = ValueGrid::with_motion(horizon, speed, &free);
+    let mut layer: HashSet<(i32, i32)> = HashSet::from([(0, 0)]);
+    for t in 1..=horizon {
+        layer = layer
+            .iter()
+            .flat_map(|&p| one_step(&free, e, p, speed))
+            .collect();
+        for dr in -e..=e {
+            for dc in -e..=e {
+                assert_eq!(
+                    g.reachable(t, dc, dr),
+                    layer.contains(&(dc, dr)),
+                    "t {t} ({dc}, {dr})"
+                );
+            }
+        }
+    }
+    // The wall's far side is reached (through its gap).
+    assert!(layer.iter().any(|&(dc, _)| dc > e - 5));
+}
+
 #[test]
 fn step_displacements_are_rings_then_rows() {
     assert_eq!(step_displacements(1), &MOVES);
