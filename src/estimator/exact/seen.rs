@@ -136,9 +136,11 @@ impl RayHits {
             pieces.clear();
             Self::weighted_pieces(sr, observed, keys, sights, speeds, pieces);
             Self::by_ray(sr.dirs.len(), pieces, sorted);
+            // With obstacles the seen sets are read by prefix sums.
+            let prefix = !sights.is_empty();
             let hits = speeds
                 .iter()
-                .map(|&speed| Self::weighted_sweep(sr, sorted, speed))
+                .map(|&speed| Self::weighted_sweep(sr, sorted, speed, prefix))
                 .collect();
             // A scratch grown past the cap is not kept.
             if pieces.capacity() > MAX_KEPT_PIECES {
@@ -244,12 +246,21 @@ impl RayHits {
 
     /// The seen sets of a class of speed `speed` from the pieces of every
     /// look, sorted by ray: each pushed by `speed·s`, left out when its
-    /// look's interval then starts past the ray's exit.
-    fn weighted_sweep(sr: &SourceRays, pieces: &[RayPiece], speed: f64) -> Self {
+    /// look's interval then starts past the ray's exit. With `prefix`, the
+    /// prefix sums of [`RayHits::with_prefix`] too, ray by ray while its
+    /// intervals are at hand.
+    fn weighted_sweep(sr: &SourceRays, pieces: &[RayPiece], speed: f64, prefix: bool) -> Self {
         let n = sr.dirs.len();
         let mut offsets = vec![0u32; n + 1];
-        let mut hits: Vec<(f64, f64)> = Vec::new();
-        let mut detected: Vec<f64> = Vec::new();
+        // A ray's sweep makes fewer than twice as many intervals as it has
+        // pieces.
+        let mut hits: Vec<(f64, f64)> = Vec::with_capacity(2 * pieces.len());
+        let mut detected: Vec<f64> = Vec::with_capacity(2 * pieces.len());
+        let mut out = RayHits::default();
+        if prefix {
+            out.ends.reserve(2 * pieces.len());
+            out.prefix.reserve(2 * pieces.len());
+        }
         let mut sweep = Sweep::default();
         let mut i = 0;
         for m in 0..n {
@@ -274,15 +285,15 @@ impl RayHits {
                     }
                 }
             });
+            if prefix {
+                out.push_prefix(&hits[first..], &detected[first..]);
+            }
             offsets[m + 1] = hits.len() as u32;
         }
-        RayHits {
-            offsets,
-            hits,
-            detected,
-            ends: Vec::new(),
-            prefix: Vec::new(),
-        }
+        out.offsets = offsets;
+        out.hits = hits;
+        out.detected = detected;
+        out
     }
 
     /// Seen sets of certain looks: unions of intervals.
@@ -594,23 +605,40 @@ impl RayHits {
     /// The same seen sets with the prefix sums that
     /// [`RayHits::detected_upto`] reads.
     pub(super) fn with_prefix(mut self) -> Self {
-        let mut prefix = Vec::with_capacity(self.hits.len());
-        for m in 0..self.offsets.len().saturating_sub(1) {
-            let mut acc = 0.0;
-            for i in self.offsets[m] as usize..self.offsets[m + 1] as usize {
-                let (a, b) = self.hits[i];
-                let detected = self.detected.get(i).copied().unwrap_or(1.0);
-                prefix.push(Prefix {
-                    start: a,
-                    before: acc,
-                    detected,
-                });
-                acc += (b - a) * detected;
-            }
+        if !self.prefix.is_empty() || self.hits.is_empty() {
+            return self;
         }
-        self.ends = self.hits.iter().map(|&(_, b)| b).collect();
-        self.prefix = prefix;
+        let ones = vec![1.0; if self.certain() { self.hits.len() } else { 0 }];
+        let detected = if self.certain() {
+            &ones
+        } else {
+            &self.detected
+        };
+        let mut out = Self::default();
+        out.prefix.reserve(self.hits.len());
+        out.ends.reserve(self.hits.len());
+        for m in 0..self.offsets.len().saturating_sub(1) {
+            let ray = self.offsets[m] as usize..self.offsets[m + 1] as usize;
+            out.push_prefix(&self.hits[ray.clone()], &detected[ray]);
+        }
+        self.ends = out.ends;
+        self.prefix = out.prefix;
         self
+    }
+
+    /// Appends one ray's prefix sums: its intervals `hits`, each with its
+    /// detection probability.
+    fn push_prefix(&mut self, hits: &[(f64, f64)], detected: &[f64]) {
+        let mut acc = 0.0;
+        for (&(a, b), &detected) in hits.iter().zip(detected) {
+            self.prefix.push(Prefix {
+                start: a,
+                before: acc,
+                detected,
+            });
+            self.ends.push(b);
+            acc += (b - a) * detected;
+        }
     }
 
     /// `∫_{−∞}^{x} detected` along ray `m` as of step 0 (needs
