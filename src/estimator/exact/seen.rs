@@ -69,7 +69,18 @@ pub(super) struct RayHits {
     /// earlier intervals and its detection probability, together so that
     /// a search's answer is one read.
     prefix: Vec<Prefix>,
+    /// Per ray, the end of every full block of [`BLOCK`] of its intervals
+    /// (`tops[top_offsets[m]..top_offsets[m+1]]`): a search counts the
+    /// blocks that end before its point, then the ends in the next block,
+    /// two short scans instead of a binary search's chain of dependent
+    /// reads.
+    tops: Vec<f64>,
+    top_offsets: Vec<u32>,
 }
+
+/// Intervals per block of [`RayHits::detected_upto`]'s search: sixteen ends,
+/// two cache lines.
+const BLOCK: usize = 16;
 
 /// One interval of a seen set as [`RayHits::detected_upto`] reads it.
 #[derive(Clone, Copy, Default)]
@@ -412,6 +423,8 @@ impl RayHits {
             detected: Vec::new(),
             ends: Vec::new(),
             prefix: Vec::new(),
+            tops: Vec::new(),
+            top_offsets: Vec::new(),
         }
     }
 
@@ -430,6 +443,8 @@ impl RayHits {
             + self.detected.capacity() * 8
             + self.ends.capacity() * 8
             + self.prefix.capacity() * std::mem::size_of::<Prefix>()
+            + self.tops.capacity() * 8
+            + self.top_offsets.capacity() * 4
     }
 
     /// The union of two unions of certain looks on the same rays, `a`'s
@@ -576,6 +591,8 @@ impl RayHits {
             detected,
             ends: Vec::new(),
             prefix: Vec::new(),
+            tops: Vec::new(),
+            top_offsets: Vec::new(),
         }
     }
 
@@ -605,7 +622,7 @@ impl RayHits {
     /// The same seen sets with the prefix sums that
     /// [`RayHits::detected_upto`] reads.
     pub(super) fn with_prefix(mut self) -> Self {
-        if !self.prefix.is_empty() || self.hits.is_empty() {
+        if self.top_offsets.len() == self.offsets.len() {
             return self;
         }
         let ones = vec![1.0; if self.certain() { self.hits.len() } else { 0 }];
@@ -623,12 +640,20 @@ impl RayHits {
         }
         self.ends = out.ends;
         self.prefix = out.prefix;
+        self.tops = out.tops;
+        self.top_offsets = out.top_offsets;
         self
     }
 
     /// Appends one ray's prefix sums: its intervals `hits`, each with its
     /// detection probability.
     fn push_prefix(&mut self, hits: &[(f64, f64)], detected: &[f64]) {
+        if self.top_offsets.is_empty() {
+            self.top_offsets.push(0);
+        }
+        self.tops
+            .extend(hits.iter().skip(BLOCK - 1).step_by(BLOCK).map(|&(_, b)| b));
+        self.top_offsets.push(self.tops.len() as u32);
         let mut acc = 0.0;
         for (&(a, b), &detected) in hits.iter().zip(detected) {
             self.prefix.push(Prefix {
@@ -641,6 +666,19 @@ impl RayHits {
         }
     }
 
+    /// Seen sets from their parts: per ray `m`, the sorted disjoint
+    /// intervals `hits[offsets[m]..offsets[m+1]]`, each with its detection
+    /// probability.
+    #[cfg(test)]
+    pub(super) fn from_parts(offsets: Vec<u32>, hits: Vec<(f64, f64)>, detected: Vec<f64>) -> Self {
+        Self {
+            offsets,
+            hits,
+            detected,
+            ..Self::default()
+        }
+    }
+
     /// `∫_{−∞}^{x} detected` along ray `m` as of step 0 (needs
     /// [`RayHits::with_prefix`]): a search of the ray's ends, so that a
     /// part of a ray is measured without walking or sorting its pieces (a
@@ -649,8 +687,16 @@ impl RayHits {
     pub(super) fn detected_upto(&self, m: usize, x: f64) -> f64 {
         let (lo, hi) = (self.offsets[m] as usize, self.offsets[m + 1] as usize);
         let ends = &self.ends[lo..hi];
-        // The first piece that ends after x.
-        let j = ends.partition_point(|&e| e <= x);
+        // The first piece that ends after x: the ends are sorted, so the
+        // number of them at most x, counted block by block.
+        let tops = &self.tops[self.top_offsets[m] as usize..self.top_offsets[m + 1] as usize];
+        let full = if tops.len() <= 4 * BLOCK {
+            tops.iter().filter(|&&e| e <= x).count()
+        } else {
+            tops.partition_point(|&e| e <= x)
+        };
+        let block = &ends[BLOCK * full..ends.len().min(BLOCK * (full + 1))];
+        let j = BLOCK * full + block.iter().filter(|&&e| e <= x).count();
         match self.prefix[lo..hi].get(j) {
             Some(p) if x > p.start => p.before + (x - p.start) * p.detected,
             Some(p) => p.before,

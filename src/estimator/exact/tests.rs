@@ -614,3 +614,53 @@ fn windows_against_per_cell(
     }
     (compared, windowed)
 }
+
+/// `detected_upto` (its block-by-block count of the ends) against the
+/// detected length up to `x` summed interval by interval, on rays of 0 to
+/// 2,000 intervals (past the count's linear scan of block ends), at every
+/// end, start and midpoint and outside the intervals.
+#[test]
+fn detected_upto_is_the_detected_length_up_to_a_point() {
+    let lengths = [0usize, 1, 7, 15, 16, 17, 31, 32, 33, 100, 255, 2000];
+    let (mut offsets, mut hits, mut detected) = (vec![0u32], Vec::new(), Vec::new());
+    for (m, &n) in lengths.iter().enumerate() {
+        let mut x = m as f64;
+        for i in 0..n {
+            // Gaps and lengths that vary, some intervals touching.
+            let gap = if i % 3 == 0 {
+                0.0
+            } else {
+                0.25 + (i % 5) as f64 * 0.1
+            };
+            let len = 0.5 + (i * 7 % 11) as f64 * 0.05;
+            hits.push((x + gap, x + gap + len));
+            detected.push(0.3 + (i % 7) as f64 * 0.1);
+            x += gap + len;
+        }
+        offsets.push(hits.len() as u32);
+    }
+    let seen = RayHits::from_parts(offsets.clone(), hits.clone(), detected.clone()).with_prefix();
+    for m in 0..lengths.len() {
+        let ray = offsets[m] as usize..offsets[m + 1] as usize;
+        let reference = |x: f64| -> f64 {
+            hits[ray.clone()]
+                .iter()
+                .zip(&detected[ray.clone()])
+                .map(|(&(a, b), &d)| (b.min(x) - a).max(0.0) * d)
+                .sum()
+        };
+        let mut points = vec![-1.0, 1e9, f64::INFINITY, f64::NEG_INFINITY];
+        for &(a, b) in &hits[ray.clone()] {
+            points.extend([a, b, 0.5 * (a + b), a - 1e-9, b + 1e-9]);
+        }
+        for x in points {
+            let (got, want) = (seen.detected_upto(m, x), reference(x));
+            let tolerance = 1e-12 * want.abs().max(1.0);
+            assert!(
+                (got - want).abs() <= tolerance,
+                "ray {m} of {} intervals at {x}: {got} against {want}",
+                lengths[m]
+            );
+        }
+    }
+}
