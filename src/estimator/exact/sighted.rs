@@ -36,7 +36,7 @@ use super::ExactEstimator;
 use super::cell_sights::{CellSight, CutDetection, CutDetections, cell_sight};
 use super::sight_index::{CellView, hidden_parts};
 use super::windows::{BlockSums, Window};
-use crate::estimator::elementary::{Block, ElementaryGrid, Segment, trace};
+use crate::estimator::elementary::{ElementaryGrid, Segment, trace};
 use crate::geometry::{Point, detection_pieces};
 use crate::limits::MAX_SPEED_CLASSES;
 use crate::obstacle::Sight;
@@ -574,52 +574,43 @@ impl ExactEstimator<'_> {
             return kept;
         }
         let group: Vec<&Excluded<'_>> = group.into_iter().map(|(_, x)| x).collect();
-        let group = &group[..];
-        let mut hull = group[0].0.region.rect;
-        for (x, _) in group {
-            hull = hull.hull(&x.region.rect);
-        }
-        let block = grid.covering(&hull);
-        let (a0, a1, b0, _) = block;
-        let na = a1 - a0;
-        let mut detected = vec![0.0; na * (block.3 - b0)];
-        self.detect_on_rays(grid, block, t, group, scratch, |a, b, d| {
-            detected[(b - b0) * na + (a - a0)] += d;
-        });
-        self.cut_detections
-            .keep(key, CutDetection::new(block, detected))
+        let detected = self.detect_on_rays(grid, t, &group, scratch);
+        self.cut_detections.keep(key, detected)
     }
 
-    /// Calls `f(a, b, detected)` for each rectangle `(a, b)` of `block`
-    /// and each part of a ray in it that the looks `cut` see at step `t`:
-    /// the unseen mass there times the chance that some look of `cut`
-    /// detects it (see [`ExactEstimator::less_what_cut_looks_detect`]).
+    /// What the looks `cut` detect at step `t` of each rectangle of the
+    /// block covering their fields of view: on each part of a ray in a
+    /// rectangle that they see, the unseen mass there times the chance
+    /// that some look of `cut` detects it (see
+    /// [`ExactEstimator::less_what_cut_looks_detect`]).
     fn detect_on_rays(
         &self,
         grid: &ElementaryGrid,
-        block: Block,
         t: usize,
         cut: &[&Excluded<'_>],
         scratch: &mut Scratch,
-        mut f: impl FnMut(usize, usize, f64),
-    ) {
+    ) -> CutDetection {
+        let mut hull = cut[0].0.region.rect;
+        for (x, _) in cut {
+            hull = hull.hull(&x.region.rect);
+        }
+        let block = grid.covering(&hull);
+        let (a0, a1, b0, b1) = block;
+        let na = a1 - a0;
+        let mut by_rect = vec![0.0; na * (b1 - b0)];
         let rect = crate::geometry::Rect {
-            x0: grid.xs[block.0],
-            x1: grid.xs[block.1],
-            y0: grid.ys[block.2],
-            y1: grid.ys[block.3],
+            x0: grid.xs[a0],
+            x1: grid.xs[a1],
+            y0: grid.ys[b0],
+            y1: grid.ys[b1],
         };
         // The rays that may meet a cut look inside the block.
-        let mut bbox = cut[0].0.region.rect;
-        for (x, _) in cut {
-            bbox = bbox.hull(&x.region.rect);
-        }
         let region = crate::geometry::Region {
-            rect: bbox.intersect(&rect),
+            rect: hull.intersect(&rect),
             disk: None,
         };
         if region.rect.is_empty() {
-            return;
+            return CutDetection::new(block, by_rect);
         }
         let within = crate::geometry::Region { rect, disk: None };
         let Scratch {
@@ -672,10 +663,11 @@ impl ExactEstimator<'_> {
                             detected += class.weight * ((to - from) - (end - upto[slot]));
                             upto[slot] = end;
                         }
-                        f(a, b, q * detected);
+                        by_rect[(b - b0) * na + (a - a0)] += q * detected;
                     });
                 }
             }
         }
+        CutDetection::new(block, by_rect)
     }
 }
