@@ -232,6 +232,31 @@ impl ExactEstimator<'_> {
                 self.less_what_cut_looks_detect(grid, &mut part, t, &cut, &mut scratch);
                 (grid, part.block_sums(grid, block, &whole))
             });
+        // A look that sees over every obstacle, with the windows: its whole
+        // square by a block sum, and the reported targets in it (what
+        // `sighted_at` gives it), without a sight or the excluded looks
+        // near each cell to look up.
+        let slot = s.types[ty].fov_slot;
+        if let (true, Some((grid, sums))) = (s.sees_over[slot], &windowed) {
+            let p_detect = s.types[ty].p_detect;
+            out.fill_step(t, |dc, dr| {
+                let k = Cell {
+                    col: start.col + dc,
+                    row: start.row + dr,
+                };
+                if !s.on_lattice(k) {
+                    return None;
+                }
+                let fk = s.fov_region_of(ty, k);
+                let known: f64 = known
+                    .iter()
+                    .filter(|&&(p, _)| fk.contains(p))
+                    .map(|&(_, miss)| miss)
+                    .sum();
+                Some(p_detect * (known + sums.sum(grid.span(slot, k))))
+            });
+            return;
+        }
         let mut refs = Vec::with_capacity(near.len());
         out.fill_step(t, |dc, dr| {
             let k = Cell {
