@@ -6,7 +6,7 @@ use std::cell::RefCell;
 use std::fmt;
 use std::sync::Arc;
 
-use crate::limits::MAX_SENSOR_SPEED;
+use crate::limits::{MAX_HORIZON, MAX_SENSOR_SPEED};
 
 /// The nine moves `(dc, dr)` of one step at speed 1, in tie-breaking order
 /// (the same as `step_displacements(1)`).
@@ -72,6 +72,10 @@ pub fn step_displacements(speed: usize) -> &'static [(i32, i32)] {
     }
 }
 
+// `Motion::build` keeps a row of offsets, shifted by the speed, in 128
+// bits: the fastest sensor's longest horizon must fit.
+const _: () = assert!(2 * MAX_SENSOR_SPEED * MAX_HORIZON + 1 + MAX_SENSOR_SPEED <= 128);
+
 /// First step of an offset that is never reachable.
 const NEVER: u32 = u32::MAX;
 
@@ -131,8 +135,8 @@ impl Motion {
         let mut first = vec![NEVER; n];
         let mut steps = vec![0u64; n];
         // Each row's free offsets as bits, shifted up by m so that the
-        // window of a column c is the row's bits c..c+2m (side ≤ 2·3·12+1
-        // fits in 128 bits with the shift).
+        // window of a column c is the row's bits c..c+2m (the widest row
+        // fits with the shift: checked at compile time above).
         let rows: Vec<u128> = free
             .chunks(side)
             .map(|row| {
