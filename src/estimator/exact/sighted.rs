@@ -239,6 +239,11 @@ impl ExactEstimator<'_> {
         let slot = s.types[ty].fov_slot;
         if let (true, Some((grid, sums))) = (s.sees_over[slot], &windowed) {
             let p_detect = s.types[ty].p_detect;
+            // The reported targets level with a row of cells' views (the
+            // cells come row by row): a cell tests only those, in the same
+            // order, so it sums the same ones.
+            let mut row: Option<(f64, f64)> = None;
+            let mut level: Vec<(Point, f64)> = Vec::new();
             out.fill_step(t, |dc, dr| {
                 let k = Cell {
                     col: start.col + dc,
@@ -248,7 +253,13 @@ impl ExactEstimator<'_> {
                     return None;
                 }
                 let fk = s.fov_region_of(ty, k);
-                let known: f64 = known
+                let (y0, y1) = (fk.rect.y0, fk.rect.y1);
+                if row != Some((y0, y1)) {
+                    row = Some((y0, y1));
+                    level.clear();
+                    level.extend(known.iter().filter(|(p, _)| p.y >= y0 && p.y <= y1));
+                }
+                let known: f64 = level
                     .iter()
                     .filter(|&&(p, _)| fk.contains(p))
                     .map(|&(_, miss)| miss)
