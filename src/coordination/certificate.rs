@@ -375,10 +375,7 @@ impl<'f, 'a> Relaxation<'f, 'a> {
                         .collect();
                     grid.fill_step(t, |dc, dr| {
                         let v = solo.get(t, dc, dr)?;
-                        let k = Cell {
-                            col: start.col + dc,
-                            row: start.row + dr,
-                        };
+                        let k = start.offset(dc, dr);
                         let (a0, a1, b0, b1) = el.block(ty.fov_slot, k);
                         let mut cut =
                             p[b1 * w + a1] - p[b0 * w + a1] - p[b1 * w + a0] + p[b0 * w + a0];

@@ -279,10 +279,7 @@ impl Fleet<'_> {
             .best
             .offsets()
             .into_iter()
-            .map(|(dc, dr)| Cell {
-                col: self.starts[i].col + dc,
-                row: self.starts[i].row + dr,
-            })
+            .map(|(dc, dr)| self.starts[i].offset(dc, dr))
             .collect();
         FirstSearch {
             plan: SensorPlan {
@@ -345,13 +342,7 @@ impl Fleet<'_> {
 /// steps.
 pub fn sensor_motion(scenario: &Scenario, start: Cell, ty: usize, horizon: usize) -> ValueGrid {
     ValueGrid::with_motion(horizon, scenario.types[ty].speed, |dc, dr| {
-        scenario.is_free(
-            ty,
-            Cell {
-                col: start.col + dc,
-                row: start.row + dr,
-            },
-        )
+        scenario.is_free(ty, start.offset(dc, dr))
     })
 }
 
@@ -378,10 +369,7 @@ pub fn search(grid: ValueGrid, start: Cell) -> SensorPlan {
     let path = moves
         .iter()
         .map(|&(dc, dr)| {
-            c = Cell {
-                col: c.col + dc,
-                row: c.row + dr,
-            };
+            c = c.offset(dc, dr);
             c
         })
         .collect();

@@ -97,10 +97,7 @@ pub fn best_responses(
                         i,
                         &mut |t, g| {
                             g.fill_step(t, |dc, dr| {
-                                let k = Cell {
-                                    col: starts[i].col + dc,
-                                    row: starts[i].row + dr,
-                                };
+                                let k = starts[i].offset(dc, dr);
                                 Some(fleet.rank_change(&current, order, rank, k, t))
                             });
                         },

@@ -97,13 +97,9 @@ pub trait Estimator: Sync {
     /// would.
     fn fill(&self, sensor: usize, start: Cell, t: usize, excluded: &[Look], grid: &mut ValueGrid) {
         grid.fill_step(t, |dc, dr| {
-            let k = Cell {
-                col: start.col + dc,
-                row: start.row + dr,
-            };
             self.scenario()
-                .on_lattice(k)
-                .then(|| self.value(sensor, k, t, excluded))
+                .lattice_cell(start, dc, dr)
+                .map(|k| self.value(sensor, k, t, excluded))
         });
     }
 

@@ -71,13 +71,7 @@ impl<'a> PaperEstimator<'a> {
                 let mut overlap = Vec::with_capacity(((2 * h + 1) * (2 * h + 1)) as usize);
                 for dr in -h..=h {
                     for dc in -h..=h {
-                        let fk = scenario.fov_region_of(
-                            ty,
-                            Cell {
-                                col: cell.col + dc,
-                                row: cell.row + dr,
-                            },
-                        );
+                        let fk = scenario.fov_region_of(ty, cell.offset(dc, dr));
                         let area = fk.area();
                         let kappa = if (dc, dr) == (0, 0) || area <= 0.0 {
                             1.0

@@ -125,6 +125,18 @@ pub struct Cell {
     pub row: i32,
 }
 
+impl Cell {
+    /// The cell `dc` columns east and `dr` rows north of this one, on the
+    /// lattice or not.
+    #[inline]
+    pub fn offset(self, dc: i32, dr: i32) -> Cell {
+        Cell {
+            col: self.col + dc,
+            row: self.row + dr,
+        }
+    }
+}
+
 /// A validated scenario.
 #[derive(Debug, Clone)]
 pub struct Scenario {
@@ -525,6 +537,13 @@ impl Scenario {
     #[inline]
     pub fn on_lattice(&self, c: Cell) -> bool {
         c.col >= 0 && c.row >= 0 && c.col < self.cols && c.row < self.rows
+    }
+
+    /// The cell `(dc, dr)` away from `start`, if it lies on the lattice.
+    #[inline]
+    pub fn lattice_cell(&self, start: Cell, dc: i32, dr: i32) -> Option<Cell> {
+        let k = start.offset(dc, dr);
+        self.on_lattice(k).then_some(k)
     }
 
     /// Centre of a cell.

@@ -393,13 +393,9 @@ impl<'e> FirstDetections<'e> {
             }
             for t in 1..=horizon {
                 grid.for_each_reachable(t, |dc, dr| {
-                    let k = Cell {
-                        col: start.col + dc,
-                        row: start.row + dr,
-                    };
-                    if !s.on_lattice(k) {
+                    let Some(k) = s.lattice_cell(start, dc, dr) else {
                         return;
-                    }
+                    };
                     let first = stops.pieces.len();
                     self.pieces(&s.look(ty, k), t, &mut stops.pieces, &mut buf);
                     if first == 0 {

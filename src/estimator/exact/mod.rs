@@ -656,11 +656,8 @@ impl Estimator for ExactEstimator<'_> {
             .filter(|_| self.starts.get(sensor) == Some(&start))
         else {
             out.fill_step(t, |dc, dr| {
-                let k = Cell {
-                    col: start.col + dc,
-                    row: start.row + dr,
-                };
-                s.on_lattice(k).then(|| self.value(sensor, k, t, excluded))
+                s.lattice_cell(start, dc, dr)
+                    .map(|k| self.value(sensor, k, t, excluded))
             });
             return;
         };
@@ -688,13 +685,7 @@ impl Estimator for ExactEstimator<'_> {
             }
         }
         out.fill_step(t, |dc, dr| {
-            let k = Cell {
-                col: start.col + dc,
-                row: start.row + dr,
-            };
-            if !s.on_lattice(k) {
-                return None;
-            }
+            let k = s.lattice_cell(start, dc, dr)?;
             let unseen = sums.sum(grid.span(ty.fov_slot, k));
             let fk = s.fov_region_of(self.types[sensor], k);
             let mut known = clear.iter().filter(|&&p| fk.contains(p)).count() as f64;

@@ -245,13 +245,7 @@ impl ExactEstimator<'_> {
             let mut row: Option<(f64, f64)> = None;
             let mut level: Vec<(Point, f64)> = Vec::new();
             out.fill_step(t, |dc, dr| {
-                let k = Cell {
-                    col: start.col + dc,
-                    row: start.row + dr,
-                };
-                if !s.on_lattice(k) {
-                    return None;
-                }
+                let k = s.lattice_cell(start, dc, dr)?;
                 let fk = s.fov_region_of(ty, k);
                 let (y0, y1) = (fk.rect.y0, fk.rect.y1);
                 if row != Some((y0, y1)) {
@@ -270,13 +264,7 @@ impl ExactEstimator<'_> {
         }
         let mut refs = Vec::with_capacity(near.len());
         out.fill_step(t, |dc, dr| {
-            let k = Cell {
-                col: start.col + dc,
-                row: start.row + dr,
-            };
-            if !s.on_lattice(k) {
-                return None;
-            }
+            let k = s.lattice_cell(start, dc, dr)?;
             let fk = s.fov_region_of(ty, k);
             refs.clear();
             refs.extend(near.iter().filter(|(x, _)| x.region.may_overlap(&fk)));

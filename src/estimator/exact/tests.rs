@@ -576,13 +576,9 @@ fn windows_against_per_cell(
                 let e = (speed * horizon) as i32;
                 for t in 1..=horizon {
                     for (dc, dr) in [(0, 0), (e, 0), (-e, e), (1, -1)] {
-                        let k = Cell {
-                            col: start.col + dc,
-                            row: start.row + dr,
-                        };
-                        if !s.on_lattice(k) {
+                        let Some(k) = s.lattice_cell(start, dc, dr) else {
                             continue;
-                        }
+                        };
                         let (va, vb) = (
                             est.value(i, k, t, excluded),
                             per_cell.value(i, k, t, excluded),
