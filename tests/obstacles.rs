@@ -308,8 +308,13 @@ struct Yard {
 
 impl Yard {
     fn new(rays_per_pi: Option<f64>) -> Self {
+        Self::with_spec(yard_spec(), rays_per_pi)
+    }
+
+    /// The yard's sensors and tracks on another spec of the same zone.
+    fn with_spec(spec: Value, rays_per_pi: Option<f64>) -> Self {
         use vigil::estimator::SourceRays;
-        let s = scenario(yard_spec());
+        let s = scenario(spec);
         let stats = (0..s.fovs.len())
             .map(|slot| Stats::for_slot(&s, slot))
             .collect();
@@ -456,9 +461,21 @@ fn values_match_a_brute_force_integral() {
 /// sensors' paths.
 #[test]
 fn path_gains_add_up_to_the_objective() {
+    check_path_gains(&Yard::new(None));
+}
+
+/// [`path_gains_add_up_to_the_objective`] on the yard without obstacles,
+/// where every look holds one piece per ray (the pair gains' own path).
+#[test]
+fn path_gains_add_up_to_the_objective_without_obstacles() {
+    let mut spec = yard_spec();
+    spec.as_object_mut().expect("an object").remove("obstacles");
+    check_path_gains(&Yard::with_spec(spec, None));
+}
+
+fn check_path_gains(yard: &Yard) {
     use vigil::coordination::sensor_motion;
     use vigil::estimator::FirstDetections;
-    let yard = Yard::new(None);
     let (s, types) = (&yard.s, &yard.types);
     let observed = yard.observed(HISTORY);
     let starts = track(0).to_vec();

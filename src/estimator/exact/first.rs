@@ -693,9 +693,47 @@ impl PathCover<'_> {
     }
 }
 
+impl PathCover<'_> {
+    /// [`PathGain::gain`] on top of one earlier stop (`earlier`, its
+    /// pieces' indices) when a look holds one piece per key: the pair gains
+    /// of the search. The same operations as [`PathCover::gain_in`] with
+    /// one earlier piece, in the same order, without its buffers.
+    fn pair_gain(&self, mine: std::ops::Range<usize>, earlier: std::ops::Range<usize>) -> f64 {
+        let pieces = &self.stops.pieces;
+        let mut c = earlier.start;
+        let mut total = 0.0;
+        for i in mine {
+            let x = pieces[i];
+            while c < earlier.end && pieces[c].key < x.key {
+                c += 1;
+            }
+            let q = match pieces.get(c) {
+                Some(q) if c < earlier.end && q.key == x.key && q.b > x.a && q.a < x.b => q,
+                _ => {
+                    total += self.alone[i];
+                    continue;
+                }
+            };
+            let ((qa, qb), (ga, gb)) = (self.ends[c], self.ends[i]);
+            let known = [(q.a, qa), (q.b, qb), (x.a, ga), (x.b, gb)];
+            let g = |v: f64| known.iter().find(|k| k.0 == v).map_or(0.0, |k| k.1);
+            let mut left = (x.b - x.a) - (gb - ga);
+            let (lo, hi) = (q.a.max(x.a), q.b.min(x.b));
+            left -= q.p * ((hi - lo) - (g(hi) - g(lo)));
+            total += x.w * x.p * left;
+        }
+        total
+    }
+}
+
 impl PathGain for PathCover<'_> {
     fn gain(&self, t: usize, at: (i32, i32), before: &[Stop]) -> f64 {
         let mine = self.stops.stop(t, at);
+        if let [(u, off)] = *before
+            && self.stops.per_key == 1
+        {
+            return self.pair_gain(mine, self.stops.stop(u, off));
+        }
         // The earlier stops' pieces, and a cursor in each.
         let mut earlier = [(0usize, 0usize); MAX_HORIZON];
         for (e, &(u, off)) in earlier.iter_mut().zip(before) {
