@@ -669,6 +669,11 @@ impl PathCover<'_> {
                 continue;
             }
             let (ga, gb) = self.ends[i];
+            if n == 1 {
+                // One earlier piece (the common case): no sweep.
+                total += gain_over_one(&x, (ga, gb), over[0], (known[0].1, known[1].1));
+                continue;
+            }
             known[2 * n] = (x.a, ga);
             known[2 * n + 1] = (x.b, gb);
             let known = &known[..2 * n + 2];
@@ -677,23 +682,14 @@ impl PathCover<'_> {
             // ∫ u·(1 − det_earlier) over the piece: its length less what is
             // detected already, less what the earlier stops detect of the rest.
             let mut left = (x.b - x.a) - (gb - ga);
-            if n == 1 {
-                // One earlier piece (the common case): no sweep.
-                let (a, b, d) = over[0];
-                let (lo, hi) = (a.max(x.a), b.min(x.b));
-                left -= d * ((hi - lo) - (g(hi) - g(lo)));
-            } else {
-                detection_pieces(&over[..n], x.a, x.b, events, |a, b, d| {
-                    left -= d * ((b - a) - (g(b) - g(a)));
-                });
-            }
+            detection_pieces(&over[..n], x.a, x.b, events, |a, b, d| {
+                left -= d * ((b - a) - (g(b) - g(a)));
+            });
             total += x.w * x.p * left;
         }
         total
     }
-}
 
-impl PathCover<'_> {
     /// [`PathGain::gain`] on top of one earlier stop (`earlier`, its
     /// pieces' indices) when a look holds one piece per key: the pair gains
     /// of the search. The same operations as [`PathCover::gain_in`] with
@@ -707,23 +703,30 @@ impl PathCover<'_> {
             while c < earlier.end && pieces[c].key < x.key {
                 c += 1;
             }
-            let q = match pieces.get(c) {
-                Some(q) if c < earlier.end && q.key == x.key && q.b > x.a && q.a < x.b => q,
-                _ => {
-                    total += self.alone[i];
-                    continue;
+            total += match pieces.get(c) {
+                Some(q) if c < earlier.end && q.key == x.key && q.b > x.a && q.a < x.b => {
+                    gain_over_one(&x, self.ends[i], (q.a, q.b, q.p), self.ends[c])
                 }
+                _ => self.alone[i],
             };
-            let ((qa, qb), (ga, gb)) = (self.ends[c], self.ends[i]);
-            let known = [(q.a, qa), (q.b, qb), (x.a, ga), (x.b, gb)];
-            let g = |v: f64| known.iter().find(|k| k.0 == v).map_or(0.0, |k| k.1);
-            let mut left = (x.b - x.a) - (gb - ga);
-            let (lo, hi) = (q.a.max(x.a), q.b.min(x.b));
-            left -= q.p * ((hi - lo) - (g(hi) - g(lo)));
-            total += x.w * x.p * left;
         }
         total
     }
+}
+
+/// What piece `x` adds on top of the one earlier piece `(a, b, p)` that
+/// meets it, with what the background detected up to each one's ends
+/// (`x_ends`, `q_ends`): `∫ u·(1 − det_earlier)` over `x`, times its
+/// weight and probability. The overlap's ends are ends of the two pieces.
+#[inline(always)]
+fn gain_over_one(x: &Piece, x_ends: (f64, f64), q: (f64, f64, f64), q_ends: (f64, f64)) -> f64 {
+    let ((a, b, d), (ga, gb)) = (q, x_ends);
+    let known = [(a, q_ends.0), (b, q_ends.1), (x.a, ga), (x.b, gb)];
+    let g = |v: f64| known.iter().find(|k| k.0 == v).map_or(0.0, |k| k.1);
+    let mut left = (x.b - x.a) - (gb - ga);
+    let (lo, hi) = (a.max(x.a), b.min(x.b));
+    left -= d * ((hi - lo) - (g(hi) - g(lo)));
+    x.w * x.p * left
 }
 
 impl PathGain for PathCover<'_> {
