@@ -52,6 +52,7 @@ use std::collections::VecDeque;
 use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
 use utoipa::ToSchema;
 
 use crate::coordination::{Coordination, Objective};
@@ -227,6 +228,16 @@ impl StepRequest {
             }
         }
         Ok(())
+    }
+
+    /// The SHA-256 of this request as JSON (fields in declaration order):
+    /// what tells a retry of a step, which has the same digest, from a new
+    /// step sent with the retried step's `Idempotency-Key`. Bodies that
+    /// differ only in layout, field order or number spelling have one
+    /// digest.
+    pub fn digest(&self) -> [u8; 32] {
+        let json = serde_json::to_vec(self).unwrap_or_default();
+        Sha256::digest(&json).into()
     }
 }
 

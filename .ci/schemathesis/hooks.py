@@ -157,6 +157,10 @@ UNSCHEMATISABLE = [
         r"^detections: the session would follow \d+ targets",
         "a bound on the session's tracks: this step's detections plus those kept from earlier steps",
     ),
+    (
+        r"^Idempotency-Key: `.*` named the session's last step, whose body was not this one",
+        "a header's value against the session's state: the last step's key comes with that step's body",
+    ),
 ]
 
 _RULES = [re.compile(pattern) for pattern, _ in UNSCHEMATISABLE]

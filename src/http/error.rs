@@ -95,6 +95,13 @@ pub enum ApiError {
         "session `{0}` was stepped by other requests while this step was made, and again each time it was made anew; send it again (with the same Idempotency-Key, a step already made is answered, not made twice)"
     )]
     SessionConflict(String),
+    /// A step's `Idempotency-Key` is the session's last step's, but its
+    /// body is not that step's: a new step sent with an old key, which a
+    /// replay would silently drop. 422.
+    #[error(
+        "Idempotency-Key: `{0}` named the session's last step, whose body was not this one; a retry sends the same body, and a new step a new key"
+    )]
+    IdempotencyKeyReused(String),
     /// A request header is not acceptable (e.g. an `Idempotency-Key` over
     /// its length). 400.
     #[error("{0}")]
@@ -187,6 +194,7 @@ impl ApiError {
             ApiError::Overloaded => StatusCode::SERVICE_UNAVAILABLE,
             ApiError::Timeout => StatusCode::GATEWAY_TIMEOUT,
             ApiError::Unprocessable(_)
+            | ApiError::IdempotencyKeyReused(_)
             | ApiError::PlanTooCostly { .. }
             | ApiError::PrecomputeTooCostly { .. } => StatusCode::UNPROCESSABLE_ENTITY,
             ApiError::ScenarioNotReady { .. }
@@ -220,6 +228,9 @@ impl ApiError {
                 ("session-step-conflict", "Session stepped concurrently")
             }
             ApiError::BadHeader(_) => ("bad-header", "Bad header"),
+            ApiError::IdempotencyKeyReused(_) => {
+                ("idempotency-key-reused", "Idempotency-Key reused")
+            }
             ApiError::ScenarioNotReady { .. } => ("scenario-not-ready", "Scenario not ready"),
             ApiError::QueueFull { .. } => ("precompute-queue-full", "Precompute queue full"),
             ApiError::PlanTooCostly { .. } => ("plan-too-costly", "Plan too costly"),

@@ -19,8 +19,9 @@ use super::doc::bounds::Bounds;
 use super::doc::{
     BadPath, BuiltinScenario, InvalidEvaluateRequest, InvalidFitRequest,
     InvalidInlineEvaluateRequest, InvalidInlinePlanRequest, InvalidPlanRequest, InvalidScenario,
-    InvalidSession, MalformedBody, MalformedStep, NotReady, Overloaded, PayloadTooLarge, QueueFull,
-    ScenarioNotFound, SessionConflict, SessionNotFound, Timeout, Unauthorized,
+    InvalidSession, InvalidStep, MalformedBody, MalformedStep, NotReady, Overloaded,
+    PayloadTooLarge, QueueFull, ScenarioNotFound, SessionConflict, SessionNotFound, Timeout,
+    Unauthorized,
 };
 use super::error::Problem;
 use super::{evaluate, fit, health, middleware, plan, scenarios, sessions};
@@ -80,6 +81,7 @@ Every error is an RFC 9457 problem (`application/problem+json`, schema \
             BuiltinScenario,
             InvalidScenario,
             InvalidPlanRequest,
+            InvalidStep,
             InvalidInlinePlanRequest,
             InvalidEvaluateRequest,
             InvalidInlineEvaluateRequest,

@@ -13,7 +13,9 @@
 //!   a check finds nobody moved it.
 //!
 //! Either way a step answered for an `Idempotency-Key` is answered again,
-//! unchanged, to a retry with that key ([`Refreshed::Replay`]).
+//! unchanged, to a retry with that key and the same body
+//! ([`Refreshed::Replay`]); with that key and another body it is refused
+//! ([`ApiError::IdempotencyKeyReused`]).
 
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::{Duration, Instant};
@@ -42,8 +44,9 @@ pub struct Held {
     /// The state may differ from the stored one (a step made here was not
     /// stored): reload it whatever the version.
     stale: bool,
-    /// The last step this replica made, its Idempotency-Key and answer.
-    last: Option<(String, Bytes)>,
+    /// The last step this replica made: its Idempotency-Key, request
+    /// digest and answer.
+    last: Option<(String, [u8; 32], Bytes)>,
     /// In the database: a step of another replica was stored over one
     /// made here, so look at the row before making the next (a session
     /// served by one replica at a time makes its steps from the cache).
@@ -57,6 +60,36 @@ pub enum Refreshed<'a> {
     Session(&'a mut Session),
     /// The answer already given to this Idempotency-Key.
     Replay(Bytes),
+}
+
+/// A step's `Idempotency-Key` and its request's digest
+/// ([`crate::session::StepRequest::digest`]): a retry has both of the step
+/// it retries.
+#[derive(Debug, Clone, Copy)]
+pub struct StepKey<'a> {
+    /// The header's value.
+    pub key: &'a str,
+    /// The request's digest.
+    pub digest: [u8; 32],
+}
+
+/// The answer to replay to `key` when the session's last step had its key,
+/// that step's request digest being `digest` (`None` for a step stored
+/// without one, by a replica older than digests, which is trusted).
+///
+/// # Errors
+/// [`ApiError::IdempotencyKeyReused`] when the digests differ.
+fn replay<'a>(
+    key: StepKey<'_>,
+    digest: Option<&[u8]>,
+    answer: Bytes,
+) -> Result<Refreshed<'a>, ApiError> {
+    match digest {
+        Some(digest) if digest != key.digest => {
+            Err(ApiError::IdempotencyKeyReused(key.key.to_owned()))
+        }
+        _ => Ok(Refreshed::Replay(answer)),
+    }
 }
 
 /// A cached session and what it costs.
@@ -267,18 +300,20 @@ impl SessionStore {
     /// current: in the database, reloads its state if the row moved on
     /// (building its planner with `resolve`, of the scenario's id and its
     /// spec, if nothing is loaded yet). With `key`, the answer to the last
-    /// step if it was made for that Idempotency-Key. With `touch`, marks
-    /// the session used now in the database.
+    /// step if it was made for that Idempotency-Key and request. With
+    /// `touch`, marks the session used now in the database.
     ///
     /// # Errors
     /// [`ApiError::SessionNotFound`] if the session is not live;
+    /// [`ApiError::IdempotencyKeyReused`] if the last step had `key` and
+    /// another request;
     /// [`ApiError::DatabaseUnavailable`]; `resolve`'s errors; an internal
     /// error for a stored session this server cannot read.
     pub async fn refresh<'a>(
         &self,
         id: &str,
         held: &'a mut Held,
-        key: Option<&str>,
+        key: Option<StepKey<'_>>,
         touch: bool,
         resolve: impl AsyncFnOnce(String, Vec<u8>) -> Result<Arc<Planner>, ApiError>,
     ) -> Result<Refreshed<'a>, ApiError> {
@@ -287,10 +322,10 @@ impl SessionStore {
             // In memory, or a cached state that no other replica moved on
             // lately: the step is made from it, and its compare-and-set
             // finds out if another replica moved it after all.
-            if let (Some(key), Some((last, answer))) = (key, &held.last)
-                && key == last
+            if let (Some(key), Some((last, digest, answer))) = (key, &held.last)
+                && key.key == last
             {
-                return Ok(Refreshed::Replay(answer.clone()));
+                return replay(key, Some(digest), answer.clone());
             }
             return match &mut held.session {
                 Some(session) => Ok(Refreshed::Session(session)),
@@ -299,7 +334,14 @@ impl SessionStore {
         };
         let have = cached.then_some(held.version);
         let row = db
-            .load_session(id, self.ttl, have, held.session.is_none(), key, touch)
+            .load_session(
+                id,
+                self.ttl,
+                have,
+                held.session.is_none(),
+                key.map(|k| k.key),
+                touch,
+            )
             .await?;
         let Some(row) = row else {
             self.forget(id);
@@ -309,8 +351,8 @@ impl SessionStore {
             }
             return Err(self.not_found(id));
         };
-        if let Some(answer) = row.replay {
-            return Ok(Refreshed::Replay(Bytes::from(answer)));
+        if let (Some(key), Some(answer)) = (key, row.replay) {
+            return replay(key, row.replay_digest.as_deref(), Bytes::from(answer));
         }
         if let Some(state) = row.state {
             let planner = match (&held.session, row.spec) {
@@ -373,7 +415,7 @@ impl SessionStore {
         &self,
         id: &str,
         held: &mut Held,
-        key: Option<&str>,
+        key: Option<StepKey<'_>>,
         answer: &Bytes,
     ) -> Result<bool, ApiError> {
         let Some(session) = &held.session else {
@@ -381,7 +423,7 @@ impl SessionStore {
         };
         let bytes = session.memory_bytes();
         let Some(db) = &self.db else {
-            held.last = key.map(|k| (k.to_owned(), answer.clone()));
+            held.last = key.map(|k| (k.key.to_owned(), k.digest, answer.clone()));
             self.resize(id, bytes + answer.len());
             return Ok(true);
         };
@@ -395,14 +437,14 @@ impl SessionStore {
                 held.version,
                 Snapshot::FORMAT,
                 &state,
-                key,
+                key.as_ref().map(|k| (k.key, &k.digest[..])),
                 answer,
             )
             .await?;
         if stored {
             held.version += 1;
             held.stale = false;
-            held.last = key.map(|k| (k.to_owned(), answer.clone()));
+            held.last = key.map(|k| (k.key.to_owned(), k.digest, answer.clone()));
             self.resize(id, bytes + answer.len());
         } else {
             held.shared = true;

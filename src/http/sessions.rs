@@ -23,7 +23,7 @@ use super::error::ApiError;
 use super::extract::{Json, Path, QueuedJson};
 use super::middleware::RequestStart;
 use super::planning::{plan_admitted_carried, resolve_scenario};
-use super::session_store::Refreshed;
+use super::session_store::{Refreshed, StepKey};
 use super::state::AppState;
 use crate::fit::SourceRate;
 use crate::limits::{MAX_HORIZON, MAX_IDEMPOTENCY_KEY_CHARS, MAX_MIN_SEPARATION, MAX_TARGETS};
@@ -198,14 +198,16 @@ pub async fn create(
         again. Steps of one session run one at a time, each from the state the one before \
         left, whichever replica serves them. A step sent with an `Idempotency-Key` header is \
         answered, to the byte, with the first answer to that key if the session's last \
-        step had it, and is not made again: send one to retry safely after a lost answer, \
-        a timeout or a 503.", plan_rules!()),
+        step had it and the same body (the same JSON values, whatever their layout), and is \
+        not made again: send one to retry safely after a lost answer, a timeout or a 503. \
+        The last step's key with another body is refused with 422 \
+        (`idempotency-key-reused`).", plan_rules!()),
     params(
         ("id" = String, Path, description = "Session id, from `POST /v1/sessions`."),
         ("Idempotency-Key" = Option<String>, Header, description = "Any string of 1 to 128 \
             visible ASCII characters naming this step (e.g. its number or a UUID): a retry \
-            with the key of the session's last step gets that step's answer again instead of \
-            a new step.", min_length = 1,
+            with the key and body of the session's last step gets that step's answer again \
+            instead of a new step; that key with another body is refused (422).", min_length = 1,
             pattern = r"^[\x21-\x7E]([\x20-\x7E]*[\x21-\x7E])?$"),
     ),
     request_body(content = StepRequest, description = "Sensors and detections now.",
@@ -217,7 +219,7 @@ pub async fn create(
         (status = 404, response = doc::SessionNotFound),
         (status = 409, response = doc::SessionConflict),
         (status = 413, response = doc::PayloadTooLarge),
-        (status = 422, response = doc::InvalidPlanRequest),
+        (status = 422, response = doc::InvalidStep),
         (status = 503, response = doc::NotReady),
     )
 )]
@@ -232,6 +234,10 @@ pub async fn step(
     let key = idempotency_key(&headers)?;
     let QueuedJson(req) = body?;
     req.check()?;
+    let key = key.map(|key| StepKey {
+        key,
+        digest: req.digest(),
+    });
     let mut held = shared.lock().await;
     for _ in 0..STEP_ATTEMPTS {
         let resolve = async |scenario_id, spec| stored_planner(&state, scenario_id, spec).await;

@@ -37,6 +37,8 @@ pub struct SessionRow {
     /// The answer to the last step, when its Idempotency-Key is the one
     /// asked about.
     pub replay: Option<Vec<u8>>,
+    /// The digest of that step's request, when it was stored with it.
+    pub replay_digest: Option<Vec<u8>>,
 }
 
 /// What [`PgStore::create_session`] dropped to make room.
@@ -136,7 +138,8 @@ impl PgStore {
     /// The live row of session `id`, if any. `have`: the version the
     /// caller holds (its state is then left out if unchanged); `spec`:
     /// whether to include the spec; `key`: an Idempotency-Key whose stored
-    /// answer to return; `touch`: mark the session used now.
+    /// answer (and request digest) to return; `touch`: mark the session
+    /// used now.
     ///
     /// # Errors
     /// [`DbError`] if the database is unreachable or too slow.
@@ -152,7 +155,8 @@ impl PgStore {
         let columns = "version, format, \
              CASE WHEN version IS NOT DISTINCT FROM $3 THEN NULL ELSE state END, \
              scenario_id, CASE WHEN $4 THEN spec END, \
-             CASE WHEN last_key = $5 THEN last_response END";
+             CASE WHEN last_key = $5 THEN last_response END, \
+             CASE WHEN last_key = $5 AND digest_key = $5 THEN last_digest END";
         let sql = if touch {
             format!(
                 "UPDATE sessions SET last_used = now() WHERE id = $1 AND {LIVE} RETURNING {columns}"
@@ -165,6 +169,7 @@ impl PgStore {
             i32,
             Option<Vec<u8>>,
             String,
+            Option<Vec<u8>>,
             Option<Vec<u8>>,
             Option<Vec<u8>>,
         );
@@ -180,20 +185,22 @@ impl PgStore {
             )
             .await?;
         Ok(row.map(
-            |(version, format, state, scenario_id, spec, replay)| SessionRow {
+            |(version, format, state, scenario_id, spec, replay, replay_digest)| SessionRow {
                 version,
                 format,
                 state,
                 scenario_id,
                 spec,
                 replay,
+                replay_digest,
             },
         ))
     }
 
-    /// Stores a step of session `id` made from version `base`: true if
-    /// stored (the row is then at `base + 1`), false if the row moved on
-    /// from `base`, expired or is gone.
+    /// Stores a step of session `id` made from version `base`, with its
+    /// Idempotency-Key and request digest if it had a key: true if stored
+    /// (the row is then at `base + 1`), false if the row moved on from
+    /// `base`, expired or is gone.
     ///
     /// # Errors
     /// [`DbError`] if the database is unreachable or too slow (the step
@@ -206,7 +213,7 @@ impl PgStore {
         base: i64,
         format: i32,
         state: &[u8],
-        key: Option<&str>,
+        key: Option<(&str, &[u8])>,
         response: &[u8],
     ) -> Result<bool, DbError> {
         let done = self
@@ -214,6 +221,7 @@ impl PgStore {
                 sqlx::query(&format!(
                     "UPDATE sessions SET version = version + 1, format = $4, state = $5, \
                      last_key = $6, last_response = CASE WHEN $6 IS NULL THEN NULL ELSE $7 END, \
+                     digest_key = $6, last_digest = $8, \
                      last_used = now() WHERE id = $1 AND {LIVE} AND version = $3"
                 ))
                 .bind(id)
@@ -221,8 +229,9 @@ impl PgStore {
                 .bind(base)
                 .bind(format)
                 .bind(state)
-                .bind(key)
+                .bind(key.map(|(key, _)| key))
                 .bind(response)
+                .bind(key.map(|(_, digest)| digest))
                 .execute(&self.pool),
             )
             .await?;

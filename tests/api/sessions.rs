@@ -220,10 +220,36 @@ async fn a_step_retried_with_its_idempotency_key_is_answered_not_made_again() {
     let first = step("k-0", 0.0).await.unwrap();
     assert_eq!(first.status(), StatusCode::OK);
     let first = first.bytes().await.unwrap();
-    // The retry (even with another body) gets the first answer, to the
-    // byte, and the session did not move.
-    let again = step("k-0", 5.0).await.unwrap().bytes().await.unwrap();
+    // The retry gets the first answer, to the byte, and so does one whose
+    // body has the same values laid out otherwise; the session did not
+    // move.
+    let again = step("k-0", 0.0).await.unwrap().bytes().await.unwrap();
     assert_eq!(again, first);
+    let relaid = format!(
+        "{{ \"detections\": [{{\"vy\": 0, \"vx\": 10.0, \"y\": 40, \"x\": 60.0}}],\n  \"sensors\": {} }}",
+        sensors(0.0)
+    );
+    let again = app
+        .client
+        .post(app.url(&path))
+        .header("Idempotency-Key", "k-0")
+        .header("content-type", "application/json")
+        .body(relaid)
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(again.status(), StatusCode::OK);
+    assert_eq!(again.bytes().await.unwrap(), first);
+    // The same key with another body is a new step under an old key:
+    // refused, not answered with the old step's answer (which would drop
+    // this step's detections), and the session did not move.
+    let res = step("k-0", 5.0).await.unwrap();
+    assert_problem(
+        res,
+        StatusCode::UNPROCESSABLE_ENTITY,
+        "Idempotency-Key: `k-0`",
+    )
+    .await;
     let info = json_body(app.get(&format!("/v1/sessions/{id}")).await, StatusCode::OK).await;
     assert_eq!(info["step"], 1);
     assert_eq!(info["tracks"].as_array().unwrap().len(), 1);

@@ -8,6 +8,7 @@ use std::time::{Duration, Instant};
 
 use reqwest::StatusCode;
 use serde_json::{Value, json};
+use sqlx::Connection;
 
 use crate::cluster::Cluster;
 use crate::server::{Server, body, spec};
@@ -204,7 +205,8 @@ pub async fn concurrent_steps_are_serialised(cluster: Arc<Cluster>) {
 }
 
 /// A step retried with its Idempotency-Key, on the other replica and at
-/// once on both, is answered with the first answer and made once.
+/// once on both, is answered with the first answer and made once; its key
+/// with another body is refused on both.
 pub async fn retried_steps_are_made_once(cluster: Arc<Cluster>) {
     let url = cluster.database("sessions_retry").await;
     let a = Arc::new(Server::start("a", &url, &[]));
@@ -223,6 +225,20 @@ pub async fn retried_steps_are_made_once(cluster: Arc<Cluster>) {
     let first = send(a.clone(), "step-0", 0).await;
     assert_eq!(send(b.clone(), "step-0", 0).await, first);
     assert_eq!(send(a.clone(), "step-0", 0).await, first);
+    // Its key with another body, on either replica: refused, not replayed.
+    for server in [&a, &b] {
+        let res = server
+            .post_with_key(&format!("/v1/sessions/{id}/step"), &step_body(1), "step-0")
+            .await;
+        let (status, problem) = body(res).await;
+        assert_eq!(status, StatusCode::UNPROCESSABLE_ENTITY, "{problem}");
+        assert!(
+            problem["type"]
+                .as_str()
+                .unwrap()
+                .ends_with("idempotency-key-reused")
+        );
+    }
     // The same new step through both at once: made once.
     let (x, y) = tokio::join!(
         tokio::spawn(send(a.clone(), "step-1", 1)),
@@ -234,6 +250,25 @@ pub async fn retried_steps_are_made_once(cluster: Arc<Cluster>) {
     assert_eq!(x["step"], 1);
     let (_, info) = body(b.get(&format!("/v1/sessions/{id}")).await).await;
     assert_eq!(info["step"], 2);
+    // A replica older than request digests stores a step with its key and
+    // answer only, leaving the digest of an earlier key: that key is then
+    // answered whatever the body, as before digests, not refused.
+    let mut conn = sqlx::PgConnection::connect(&url).await.unwrap();
+    sqlx::query(
+        "UPDATE sessions SET version = version + 1, last_key = 'old-2', \
+         last_response = convert_to('{\"step\":2}', 'UTF8') WHERE id = $1",
+    )
+    .bind(&id)
+    .execute(&mut conn)
+    .await
+    .unwrap();
+    for server in [&a, &b] {
+        let res = server
+            .post_with_key(&format!("/v1/sessions/{id}/step"), &step_body(5), "old-2")
+            .await;
+        assert_eq!(res.status(), StatusCode::OK);
+        assert_eq!(&res.bytes().await.unwrap()[..], br#"{"step":2}"#);
+    }
 }
 
 /// The idle time to live and the count hold across replicas: a session

@@ -168,6 +168,10 @@ def test_a_session_steps_and_is_deleted_at_the_end(vigil: Vigil) -> None:
         # Asked again under its key, the step is answered, not made again.
         again = session.step({"sensors": moved}, idempotency_key="second")
         assert again == second
+        # Its key with another request is a new step under an old key: refused.
+        with pytest.raises(VigilError) as reused:
+            session.step({"sensors": [{"id": "a", "x": 5.0, "y": 5.0}]}, idempotency_key="second")
+        assert reused.value.status == 422
         info = session.refresh()
         assert info.step == 2 and info.history_held == 2
         assert [t.id for t in info.tracks] == ["t"]

@@ -255,7 +255,8 @@ class Session:
         The step is sent with an `Idempotency-Key` (`idempotency_key`, else a new
         random one), so a resend after a 503, including the client's own waits on
         `Retry-After`, is answered rather than made twice. Pass the key of a step
-        whose answer was lost to ask for it again.
+        whose answer was lost, with the same request, to ask for it again; that
+        key with another request is refused (422, `idempotency-key-reused`).
         """
         body = _body(request, StepRequest)
         key = idempotency_key if idempotency_key is not None else uuid.uuid4().hex

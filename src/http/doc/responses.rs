@@ -152,6 +152,25 @@ pub struct BuiltinScenario(pub Problem);
 )]
 pub struct InvalidScenario(pub Problem);
 
+/// The step is well-formed but a value is outside its bounds or the
+/// scenario's zone (as for a plan: `detail` starts with the JSON path of
+/// the offending field and a colon), or it has the `Idempotency-Key` of
+/// the session's last step with another body: a new step sent with an old
+/// key, refused rather than answered with the old step's answer.
+#[derive(Debug, ToResponse)]
+#[response(
+    content_type = "application/problem+json",
+    examples(
+        ("outside" = (summary = "A sensor outside the zone", value = json!(invalid(
+            "sensors[0]", "(400, 10) is outside the zone [0,300]×[0,300]"
+        )))),
+        ("key-reused" = (summary = "The last step's Idempotency-Key with another body", value = json!(problem(
+            ApiError::IdempotencyKeyReused("step-41".to_owned())
+        )))),
+    )
+)]
+pub struct InvalidStep(pub Problem);
+
 /// The request is well-formed but a value is outside its bounds or the
 /// scenario's zone. `detail` starts with the JSON path of the offending field
 /// and a colon.

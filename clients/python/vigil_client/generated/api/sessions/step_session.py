@@ -121,9 +121,11 @@ def sync_detailed(
     whose plan is made is recorded, so a step that failed (4xx, 5xx) may be sent again. Steps of one
     session run one at a time, each from the state the one before left, whichever replica serves them. A
     step sent with an `Idempotency-Key` header is answered, to the byte, with the first answer to that
-    key if the session's last step had it, and is not made again: send one to retry safely after a lost
-    answer, a timeout or a 503. Rules no schema can state (each a 422 whose `detail` names the field):
-    every sensor and history position lies in the scenario's zone, and sensor ids are unique.
+    key if the session's last step had it and the same body (the same JSON values, whatever their
+    layout), and is not made again: send one to retry safely after a lost answer, a timeout or a 503.
+    The last step's key with another body is refused with 422 (`idempotency-key-reused`). Rules no
+    schema can state (each a 422 whose `detail` names the field): every sensor and history position lies
+    in the scenario's zone, and sensor ids are unique.
 
     Args:
         id (str):
@@ -168,9 +170,11 @@ def sync(
     whose plan is made is recorded, so a step that failed (4xx, 5xx) may be sent again. Steps of one
     session run one at a time, each from the state the one before left, whichever replica serves them. A
     step sent with an `Idempotency-Key` header is answered, to the byte, with the first answer to that
-    key if the session's last step had it, and is not made again: send one to retry safely after a lost
-    answer, a timeout or a 503. Rules no schema can state (each a 422 whose `detail` names the field):
-    every sensor and history position lies in the scenario's zone, and sensor ids are unique.
+    key if the session's last step had it and the same body (the same JSON values, whatever their
+    layout), and is not made again: send one to retry safely after a lost answer, a timeout or a 503.
+    The last step's key with another body is refused with 422 (`idempotency-key-reused`). Rules no
+    schema can state (each a 422 whose `detail` names the field): every sensor and history position lies
+    in the scenario's zone, and sensor ids are unique.
 
     Args:
         id (str):
@@ -210,9 +214,11 @@ async def asyncio_detailed(
     whose plan is made is recorded, so a step that failed (4xx, 5xx) may be sent again. Steps of one
     session run one at a time, each from the state the one before left, whichever replica serves them. A
     step sent with an `Idempotency-Key` header is answered, to the byte, with the first answer to that
-    key if the session's last step had it, and is not made again: send one to retry safely after a lost
-    answer, a timeout or a 503. Rules no schema can state (each a 422 whose `detail` names the field):
-    every sensor and history position lies in the scenario's zone, and sensor ids are unique.
+    key if the session's last step had it and the same body (the same JSON values, whatever their
+    layout), and is not made again: send one to retry safely after a lost answer, a timeout or a 503.
+    The last step's key with another body is refused with 422 (`idempotency-key-reused`). Rules no
+    schema can state (each a 422 whose `detail` names the field): every sensor and history position lies
+    in the scenario's zone, and sensor ids are unique.
 
     Args:
         id (str):
@@ -255,9 +261,11 @@ async def asyncio(
     whose plan is made is recorded, so a step that failed (4xx, 5xx) may be sent again. Steps of one
     session run one at a time, each from the state the one before left, whichever replica serves them. A
     step sent with an `Idempotency-Key` header is answered, to the byte, with the first answer to that
-    key if the session's last step had it, and is not made again: send one to retry safely after a lost
-    answer, a timeout or a 503. Rules no schema can state (each a 422 whose `detail` names the field):
-    every sensor and history position lies in the scenario's zone, and sensor ids are unique.
+    key if the session's last step had it and the same body (the same JSON values, whatever their
+    layout), and is not made again: send one to retry safely after a lost answer, a timeout or a 503.
+    The last step's key with another body is refused with 422 (`idempotency-key-reused`). Rules no
+    schema can state (each a 422 whose `detail` names the field): every sensor and history position lies
+    in the scenario's zone, and sensor ids are unique.
 
     Args:
         id (str):
