@@ -22,6 +22,7 @@
 //! [`http`] is the thin HTTP layer over them, and [`store`] keeps
 //! registered scenarios on disk.
 
+mod by_name;
 pub mod cancel;
 pub mod catalog;
 pub mod codec;

@@ -68,7 +68,7 @@ mod rounds;
 use std::time::Instant;
 
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 use utoipa::ToSchema;
 
 use crate::cancel::Cancelled;
@@ -86,7 +86,7 @@ use priority::Ranking;
 pub use rounds::MAX_ROUNDS;
 
 /// How sensors' searches are coordinated.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, ToSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum Coordination {
     /// Every sensor plans alone (the paper's 'b' rows).
@@ -101,8 +101,15 @@ pub enum Coordination {
     Joint,
 }
 
+crate::by_name::by_name!(Coordination {
+    "none" => Coordination::None,
+    "priority" => Coordination::Priority,
+    "iterated" => Coordination::Iterated,
+    "joint" => Coordination::Joint,
+});
+
 /// What a plan maximises.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, ToSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Objective {
     /// The paper's J: expected detections summed over the steps (a target
@@ -114,6 +121,11 @@ pub enum Objective {
     /// intrusion objective. Needs the `exact` estimator.
     FirstDetections,
 }
+
+crate::by_name::by_name!(Objective {
+    "detections" => Objective::Detections,
+    "first_detections" => Objective::FirstDetections,
+});
 
 /// Plans of every sensor, in request order, with their ranks.
 #[derive(Debug, Clone)]

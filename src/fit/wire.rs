@@ -8,7 +8,7 @@ use crate::planner::{Id, SensorIn};
 use crate::scenario::Integer;
 
 /// The prior on each source's rate.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, ToSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum PriorKind {
     /// Gamma with shape 1 and mean the spec's rate (flat for a source whose
@@ -18,6 +18,11 @@ pub enum PriorKind {
     /// Uniform on the rate: the posterior is Gamma(N + 1, E).
     Flat,
 }
+
+crate::by_name::by_name!(PriorKind {
+    "scenario" => PriorKind::Scenario,
+    "flat" => PriorKind::Flat,
+});
 
 /// A target detected at a step.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]

@@ -9,7 +9,7 @@ use crate::coordination::{Bound, Coordination, JointReport, Objective};
 use crate::scenario::Integer;
 
 /// Which estimator of `n̂(k,t)` to use.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, ToSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum EstimatorKind {
     /// The conditional expectation under the model (ours).
@@ -19,8 +19,13 @@ pub enum EstimatorKind {
     Paper,
 }
 
+crate::by_name::by_name!(EstimatorKind {
+    "exact" => EstimatorKind::Exact,
+    "paper" => EstimatorKind::Paper,
+});
+
 /// What the reported targets cover.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, ToSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum Observed {
     /// The targets inside the sensors' fields of view (now and in the history).
@@ -29,6 +34,11 @@ pub enum Observed {
     /// Every target in the zone (a clairvoyant reference).
     Zone,
 }
+
+crate::by_name::by_name!(Observed {
+    "sensors" => Observed::Sensors,
+    "zone" => Observed::Zone,
+});
 
 /// A sensor or target id: a string or a number, echoed back as given.
 #[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]

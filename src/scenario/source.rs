@@ -17,7 +17,7 @@ use crate::geometry::{Point, Rect};
 use crate::limits::MAX_SPEED_CLASSES;
 
 /// Direction a source's takeoff half-plane faces.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum Heading {
     /// +x.
@@ -29,6 +29,13 @@ pub enum Heading {
     /// −y.
     South,
 }
+
+crate::by_name::by_name!(Heading {
+    "east" => Heading::East,
+    "west" => Heading::West,
+    "north" => Heading::North,
+    "south" => Heading::South,
+});
 
 impl Heading {
     /// Unit vector of the heading.

@@ -96,6 +96,36 @@ async fn missing_fields_and_wrong_types_are_400() {
     spec["colour"] = json!("red");
     let res = app.post_json("/v1/scenarios", &spec).await;
     assert_problem(res, StatusCode::BAD_REQUEST, "colour").await;
+    // A name of the wrong type is refused as such, with the field and the
+    // names it may take, not as JSON that fails to parse.
+    let plan = "/v1/scenarios/paper-v10/plan";
+    let sensors = json!([{"id": "a", "x": 55.0, "y": 55.0}]);
+    for (field, value, names) in [
+        (
+            "coordination",
+            json!(3),
+            "`none`, `priority`, `iterated`, `joint`",
+        ),
+        (
+            "objective",
+            json!(["x"]),
+            "`detections`, `first_detections`",
+        ),
+        ("observed", json!({"all": true}), "`sensors`, `zone`"),
+        ("estimator", json!(true), "`exact`, `paper`"),
+    ] {
+        let res = app
+            .post_json(plan, &json!({"sensors": sensors, field: value}))
+            .await;
+        let problem = assert_problem(res, StatusCode::BAD_REQUEST, field).await;
+        let detail = problem["detail"].as_str().unwrap();
+        assert!(detail.contains("invalid type"), "{detail}");
+        assert!(detail.contains(names), "{detail}");
+        assert!(
+            !detail.contains("parse the request body as JSON"),
+            "{detail}"
+        );
+    }
 }
 
 #[tokio::test]
