@@ -552,3 +552,17 @@ fn check_path_gains(yard: &Yard) {
     }
     assert!(multi > 100, "too few paths detect anything: {multi}");
 }
+
+/// The vertices' own reader takes back what `Serialize` writes, in JSON
+/// (the API, the catalogue) and in CBOR (sessions' specs).
+#[test]
+fn obstacles_round_trip_through_json_and_cbor() {
+    let spec = vigil::scenario::site_campus_spec();
+    assert!(spec.obstacles.as_ref().is_some_and(|o| !o.is_empty()));
+    let text = serde_json::to_string(&spec).unwrap();
+    assert_eq!(serde_json::from_str::<ScenarioSpec>(&text).unwrap(), spec);
+    let mut cbor = Vec::new();
+    ciborium::into_writer(&spec, &mut cbor).unwrap();
+    let back: ScenarioSpec = ciborium::from_reader(cbor.as_slice()).unwrap();
+    assert_eq!(back, spec);
+}

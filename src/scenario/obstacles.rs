@@ -20,6 +20,7 @@ pub struct ObstacleSpec {
     /// three consecutive ones collinear. It may cross the zone's edge but
     /// not lie wholly outside it.
     #[schema(value_type = Vec<Vec<f64>>)]
+    #[serde(deserialize_with = "vertices")]
     pub polygon: Vec<[f64; 2]>,
     /// `building` (the default) blocks sight, ends the flight of a target
     /// that enters it and blocks ground sensors' cells; `screen` (trees, a
@@ -27,6 +28,45 @@ pub struct ObstacleSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(value_type = Option<ObstacleKindName>)]
     pub kind: Option<String>,
+}
+
+/// Reads a polygon's vertices, each `[x, y]`. A vertex of another length
+/// is refused as such ("invalid length 3, expected a vertex [x, y]"):
+/// serde_json says of a fixed-size array that goes on that the JSON fails
+/// to parse ("trailing characters").
+fn vertices<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>, D::Error> {
+    struct Vertex([f64; 2]);
+    impl<'de> Deserialize<'de> for Vertex {
+        fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+            struct Visitor;
+            impl<'de> serde::de::Visitor<'de> for Visitor {
+                type Value = Vertex;
+                fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                    f.write_str("a vertex [x, y]")
+                }
+                fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                    self,
+                    mut seq: A,
+                ) -> Result<Vertex, A::Error> {
+                    let mut xy = [0.0; 2];
+                    let mut len = 0;
+                    while let Some(v) = seq.next_element::<f64>()? {
+                        if let Some(slot) = xy.get_mut(len) {
+                            *slot = v;
+                        }
+                        len += 1;
+                    }
+                    if len != 2 {
+                        return Err(serde::de::Error::invalid_length(len, &self));
+                    }
+                    Ok(Vertex(xy))
+                }
+            }
+            d.deserialize_seq(Visitor)
+        }
+    }
+    let list: Vec<Vertex> = Vec::deserialize(d)?;
+    Ok(list.into_iter().map(|v| v.0).collect())
 }
 
 /// The names of the obstacle kinds (for the OpenAPI document; the spec

@@ -5,7 +5,9 @@
 use reqwest::StatusCode;
 use serde_json::{Value, json};
 
-use crate::helpers::{TestApp, assert_validation, json_body, small_spec, spawn_app};
+use crate::helpers::{
+    TestApp, assert_problem, assert_validation, json_body, small_spec, spawn_app,
+};
 
 /// `small_spec` with a building in the middle (cells (4..=5, 4..=5) have
 /// their centres in it), a screen in the south-west, a ground type
@@ -316,11 +318,28 @@ async fn malformed_obstacles_are_refused_naming_the_field() {
     let across =
         with(json!([{"polygon": [[90.0, 10.0], [120.0, 10.0], [120.0, 30.0], [90.0, 30.0]]}]));
     register(&app, &across).await;
-    // Non-numeric vertices are a 400 that names the field.
-    let res = app
-        .post_json("/v1/scenarios", &with(json!([{"polygon": [["a", 0.0]]}])))
-        .await;
-    assert!(res.status().is_client_error());
+    // Non-numeric vertices, and vertices of other than two numbers, are a
+    // 400 that names the vertex (not JSON that fails to parse).
+    for (vertex, says) in [
+        (json!(["a", 0.0]), "invalid type"),
+        (
+            json!([1.0, 2.0, 3.0]),
+            "invalid length 3, expected a vertex [x, y]",
+        ),
+        (json!([1.0]), "invalid length 1, expected a vertex [x, y]"),
+    ] {
+        let polygon = json!([vertex, [60.0, 40.0], [60.0, 60.0]]);
+        let res = app
+            .post_json("/v1/scenarios", &with(json!([{"polygon": polygon}])))
+            .await;
+        let problem = assert_problem(res, StatusCode::BAD_REQUEST, "obstacles[0].polygon[0]").await;
+        let detail = problem["detail"].as_str().unwrap();
+        assert!(detail.contains(says), "{detail}");
+        assert!(
+            !detail.contains("parse the request body as JSON"),
+            "{detail}"
+        );
+    }
 }
 
 /// The built-in campus plans for a fleet of robots and drones.
