@@ -1,0 +1,184 @@
+//! The cost models' predictions: finite and positive, growing with each
+//! term they count, and large enough to refuse (or run as a job) the
+//! issues' large work while the reference workload passes.
+
+use super::*;
+use crate::coordination::Coordination::{Iterated, Priority};
+use crate::planner::PlanRequest;
+use crate::scenario::{SourceSpec, builtins, paper_spec};
+use serde_json::json;
+
+/// `n` sensors on a near-square grid (each on the first free cell of
+/// its row), `history` steps in which they stood 0–2 cells west, and
+/// `targets` on a spiral through the zone.
+fn request(s: &Scenario, n: usize, t: usize, targets: usize, history: usize) -> PlanRequest {
+    let cols = (n as f64).sqrt().ceil() as usize;
+    let rows = n.div_ceil(cols);
+    let at = |i: usize, back: usize| {
+        let x = ((i % cols) as f64 + 0.5) * s.width / cols as f64;
+        let y = ((i / cols) as f64 + 0.5) * s.height / rows as f64;
+        let c = s.snap(Point::new(x - (back % 3) as f64 * s.cell_size, y));
+        let free = (0..s.cols)
+            .map(|k| Cell {
+                col: (c.col + k) % s.cols,
+                row: c.row,
+            })
+            .find(|&c| s.is_free(0, c))
+            .unwrap_or(c);
+        s.centre(free)
+    };
+    let sensors: Vec<_> = (0..n)
+        .map(|i| json!({"id": i, "x": at(i, 0).x, "y": at(i, 0).y}))
+        .collect();
+    let targets: Vec<_> = (0..targets)
+        .map(|k| {
+            let (a, f) = (k as f64 * 2.4, ((k % 997) as f64 + 0.5) / 997.0);
+            let (x, y) = (s.width * f.sqrt() * a.cos(), s.height * f.sqrt() * a.sin());
+            json!({"x": s.width / 2.0 + 0.49 * x, "y": s.height / 2.0 + 0.49 * y,
+                   "vx": 10.0 * a.sin(), "vy": -10.0 * a.cos()})
+        })
+        .collect();
+    let history: Vec<Vec<_>> = (1..=history)
+        .map(|h| {
+            (0..n)
+                .map(|i| json!({"x": at(i, h).x, "y": at(i, h).y}))
+                .collect()
+        })
+        .collect();
+    let body = json!({"sensors": sensors, "targets": targets, "history": history, "horizon": t});
+    serde_json::from_value(body).expect("a plan request")
+}
+
+fn plan_cost(p: &Planner, mut req: PlanRequest, c: Coordination) -> f64 {
+    req.coordination = Some(c);
+    plan_ms(p, &PlanInput::new(&p.scenario, &req).expect("valid"))
+}
+
+/// A scenario like `paper-v10` on `side × side` cells, `k` sources.
+fn lattice(side: usize, k: usize, cell: f64, fov: FovSpec) -> Scenario {
+    let w = side as f64 * cell;
+    let src = |j: usize| SourceSpec::at(w * (j as f64 + 0.5) / k as f64, -1.0, 0.3);
+    let mut spec = paper_spec(10.0);
+    (spec.zone.width, spec.zone.height, spec.cell_size, spec.fov) = (w, w, cell, fov);
+    spec.sources = (0..k).map(src).collect();
+    Scenario::new(spec).expect("a valid scenario")
+}
+
+/// First detections cost what their searches do: far above the
+/// detections objective's plan of the same request, growing with the
+/// horizon, and above the time a server would plan on its async
+/// worker (`INLINE_PLAN_MS`, 5 ms), so they never block it.
+#[test]
+fn first_detections_are_predicted_by_their_searches() {
+    let p = Planner::new(builtins().remove(0));
+    let first = |t: usize| {
+        let mut req = request(&p.scenario, 10, t, 30, 16);
+        req.objective = Some(Objective::FirstDetections);
+        plan_cost(&p, req, Iterated)
+    };
+    let j = plan_cost(&p, request(&p.scenario, 10, 3, 30, 16), Iterated);
+    assert!(first(3) > 20.0 * j && first(3) > 5.0, "{} vs {j}", first(3));
+    increasing("first detections by horizon", [3, 5, 8].map(first));
+}
+
+fn increasing(what: &str, costs: impl IntoIterator<Item = f64>) {
+    let costs: Vec<f64> = costs.into_iter().collect();
+    assert!(costs.windows(2).all(|w| w[1] > w[0]), "{what}: {costs:?}");
+}
+
+const MODES: [Coordination; 3] = [Coordination::None, Priority, Iterated];
+
+#[test]
+fn predictions_are_finite_and_positive() {
+    for s in builtins() {
+        let pre = precompute_ms(&s);
+        assert!(pre.is_finite() && pre > 0.0, "{}: {pre}", s.id);
+        let p = Planner::new(s);
+        // The paper estimator refuses scenarios with obstacles.
+        let paper = (!p.scenario.has_obstacles()).then_some(EstimatorKind::Paper);
+        for (estimator, c) in std::iter::once(EstimatorKind::Exact)
+            .chain(paper)
+            .flat_map(|e| MODES.map(|c| (e, c)))
+        {
+            for (n, targets, history) in [(1, 0, 0), (10, 50, 16), (40, 500, 4)] {
+                let mut req = request(&p.scenario, n, 3, targets, history);
+                req.estimator = Some(estimator);
+                let input = PlanInput::new(&p.scenario, &req).expect("valid");
+                let terms = plan_terms(&p, &input).to_array();
+                assert!(terms.iter().all(|t| t.is_finite() && *t >= 0.0));
+                let ms = plan_cost(&p, req, c);
+                assert!(ms.is_finite() && ms > 0.0, "{}: {ms}", p.scenario.id);
+            }
+        }
+    }
+}
+
+#[test]
+fn plan_cost_grows_with_each_driver() {
+    let p = Planner::new(builtins().remove(0));
+    let s = &p.scenario;
+    let cost = |n, t, targets, h, c| plan_cost(&p, request(s, n, t, targets, h), c);
+    increasing(
+        "sensors",
+        [1, 4, 16, 64, 256].map(|n| cost(n, 3, 50, 16, Priority)),
+    );
+    increasing("horizon", (1..=12).map(|t| cost(10, t, 50, 16, Priority)));
+    increasing(
+        "targets",
+        [0, 100, 1000, 20_000].map(|k| cost(10, 3, k, 16, Priority)),
+    );
+    increasing(
+        "history",
+        [0, 4, 16, 32].map(|h| cost(10, 3, 50, h, Priority)),
+    );
+    increasing("coordination", MODES.map(|c| cost(10, 3, 50, 16, c)));
+}
+
+/// Obstacles add the statistics' rays: more with more obstacles and
+/// more cells, none without.
+#[test]
+fn precompute_cost_grows_with_obstacles() {
+    let campus = crate::scenario::site_campus_spec();
+    let cost =
+        |spec: crate::scenario::ScenarioSpec| precompute_ms(&Scenario::new(spec).expect("valid"));
+    let without = cost(crate::scenario::ScenarioSpec {
+        obstacles: None,
+        ..campus.clone()
+    });
+    let mut four = campus.clone();
+    four.obstacles.as_mut().expect("obstacles").truncate(4);
+    let finer = crate::scenario::ScenarioSpec {
+        cell_size: 5.0,
+        ..campus.clone()
+    };
+    increasing(
+        "obstacles, then cells",
+        [without, cost(four), cost(campus), cost(finer)],
+    );
+}
+
+#[test]
+fn precompute_cost_grows_with_cells_sources_and_circles() {
+    let square = FovSpec::Square { half_width: 30.0 };
+    let cells = [30, 100, 300, 1000, 2000].map(|side| lattice(side, 8, 10.0, square));
+    increasing("cells", cells.iter().map(precompute_ms));
+    let sources = [1, 4, 16, 64].map(|k| lattice(100, k, 10.0, square));
+    increasing("sources", sources.iter().map(precompute_ms));
+    let circle = lattice(30, 8, 10.0, FovSpec::Circle { radius: 30.0 });
+    assert!(precompute_ms(&circle) > 5.0 * precompute_ms(&builtins()[0]));
+}
+
+#[test]
+fn the_issues_large_work_is_refused_or_a_job_and_the_reference_is_not() {
+    let p = Planner::new(builtins().remove(0));
+    let s = &p.scenario;
+    let large = plan_cost(&p, request(s, 256, 12, 20_000, 32), Iterated);
+    assert!(large > 2000.0, "{large} ms");
+    let reference = plan_cost(&p, request(s, 10, 3, 50, 16), Priority);
+    assert!(reference < 10.0, "{reference} ms");
+    // 2000 × 2000 cells of 1, circles of radius 40, 64 sources: built,
+    // not precomputed.
+    let big = lattice(2000, 64, 1.0, FovSpec::Circle { radius: 40.0 });
+    assert!(precompute_ms(&big) > 1000.0);
+    assert!(precompute_ms(&builtins()[0]) < 100.0);
+}
