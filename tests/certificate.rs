@@ -545,6 +545,57 @@ fn first_detections_against_the_optimum(seed: u64, instances: usize, obstacles: 
     assert!(found[2] >= found[1], "{found:?}");
 }
 
+/// A first-detections search is not run again when its sensor's path
+/// alone is provably still its best (`Fleet::first_search`: the others'
+/// looks hold none of its targets); every search runs in full when the
+/// plan reports its values (`explain`). Both give the same paths, values
+/// and bounds, on the paper's scenario with 4 to 9 sensors, in priority
+/// and iterated plans.
+#[test]
+fn first_detection_plans_are_the_same_with_every_search_run() {
+    let planner = Planner::new(vigil::scenario::builtins().swap_remove(0));
+    let s = &planner.scenario;
+    let mut rng = StdRng::seed_from_u64(67);
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(1.0);
+    for instance in 0..10 {
+        let n = rng.random_range(4..=9);
+        let coordination = if instance % 2 == 0 {
+            Coordination::Priority
+        } else {
+            Coordination::Iterated
+        };
+        let req = PlanRequest {
+            horizon: Some(3usize.into()),
+            estimator: Some(EstimatorKind::Exact),
+            objective: Some(Objective::FirstDetections),
+            coordination: Some(coordination),
+            ..random_state(&mut rng, s, n, &["default"], 6)
+        };
+        let lazy = planner.plan_request(&req).unwrap();
+        let full = PlanRequest {
+            explain: Some(true),
+            ..req.clone()
+        };
+        let full = planner.plan_request(&full).unwrap();
+        let what = format!("instance {instance}, {coordination:?}");
+        assert!(
+            close(lazy.expected_detections, full.expected_detections),
+            "{what}: {} against {}",
+            lazy.expected_detections,
+            full.expected_detections
+        );
+        for (a, b) in lazy.plans.iter().zip(&full.plans) {
+            assert_eq!(a.path, b.path, "{what}, sensor {:?}", a.sensor);
+            assert!(
+                close(a.expected_detections, b.expected_detections),
+                "{what}"
+            );
+        }
+        let (a, b) = (lazy.bound.unwrap(), full.bound.unwrap());
+        assert!(close(a.upper, b.upper), "{what}: bounds {a:?} and {b:?}");
+    }
+}
+
 /// Beyond T = 4 a sensor's search is an approximation (the pair
 /// programme's path improved within a budget): on one sensor over five
 /// steps it stays within 5% of the optimum found by scoring every legal

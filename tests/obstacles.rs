@@ -492,6 +492,8 @@ fn check_path_gains(yard: &Yard) {
     }
     let mut rng = StdRng::seed_from_u64(47);
     let mut multi = 0;
+    // Paths that `apart` finds clear of the others' looks, and the others.
+    let (mut apart, mut near) = (0, 0);
     for sensor in 0..3 {
         let (start, ty) = (starts[sensor], types[sensor]);
         let speed = s.types[ty].speed as i32;
@@ -547,10 +549,27 @@ fn check_path_gains(yard: &Yard) {
                     "sensor {sensor} on {cells:?}: gains {gains}, objective {objective}"
                 );
                 multi += usize::from(objective > 0.0);
+                if with_others {
+                    // Clear of the others' looks, the path detects first
+                    // what it detects alone.
+                    if first.apart(sensor, &cells, &paths, &others) {
+                        let own: Vec<Vec<Look>> =
+                            cells.iter().map(|&c| vec![s.look(ty, c)]).collect();
+                        let alone: f64 = first.by_step(&own).iter().sum();
+                        assert!(
+                            (alone - objective).abs() <= 1e-9 * alone.abs().max(1.0),
+                            "sensor {sensor} on {cells:?}: apart, yet {objective} against the others and {alone} alone"
+                        );
+                        apart += 1;
+                    } else {
+                        near += 1;
+                    }
+                }
             }
         }
     }
     assert!(multi > 100, "too few paths detect anything: {multi}");
+    assert!(apart >= 5 && near >= 5, "{apart} paths apart, {near} near");
 }
 
 /// The vertices' own reader takes back what `Serialize` writes, in JSON

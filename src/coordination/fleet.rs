@@ -2,6 +2,8 @@
 //! for one of them: its values at each step against some other sensors'
 //! looks, then the dynamic programme of [`crate::search`].
 
+use std::sync::OnceLock;
+
 use rayon::prelude::*;
 
 use crate::cancel::CancelToken;
@@ -45,6 +47,12 @@ pub struct Fleet<'a> {
     /// The intrusion objective, when the plan maximises first detections
     /// instead of detections (see [`Fleet::with_first_detections`]).
     pub first: Option<&'a FirstDetections<'a>>,
+    /// Every first-detections search runs in full, so that each sensor's
+    /// values are those of the search that chose its path (the plan
+    /// reports them: `explain`); see [`Fleet::first_search`].
+    pub full_searches: bool,
+    /// Each sensor's first-detections search alone, once made.
+    alone: Vec<OnceLock<FirstSearch>>,
     /// Each sensor's motion (its speed, the free cells around it), built
     /// once and shared by every search it runs.
     motions: Vec<ValueGrid>,
@@ -75,6 +83,8 @@ impl<'a> Fleet<'a> {
             min_separation,
             cancel,
             first: None,
+            full_searches: false,
+            alone: (0..starts.len()).map(|_| OnceLock::new()).collect(),
             motions,
         }
     }
@@ -246,6 +256,16 @@ impl Fleet<'_> {
     /// detects at step 1 is not there to detect at step 3), around
     /// `avoid`'s paths; with `current`, that path's exact gain too.
     ///
+    /// The sensor's search alone (no `sensors`, no `avoid`) is kept for
+    /// the later ones. When it proved its path optimal, and no look of
+    /// `sensors` holds a target that path's looks hold
+    /// ([`FirstDetections::apart`]), the path gains against them what it
+    /// gains alone, and no path gains more (a gain against more looks is
+    /// never more than alone): a later search without `avoid` returns it
+    /// unsearched, unless `current` is another path (whose gain it would
+    /// need) or [`Fleet::full_searches`] is set (the values returned are
+    /// then those alone).
+    ///
     /// # Panics
     /// On a fleet without [`Fleet::with_first_detections`].
     pub fn first_search(
@@ -257,6 +277,23 @@ impl Fleet<'_> {
         current: Option<&[Cell]>,
     ) -> FirstSearch {
         let first = self.first.expect("a fleet maximising first detections");
+        let plain = avoid.is_empty();
+        if let Some(alone) = self.alone[i].get().filter(|_| plain)
+            && current.is_none_or(|c| c == alone.plan.path)
+        {
+            let again = sensors.is_empty();
+            let unmoved = !again
+                && !self.full_searches
+                && alone.upper <= alone.plan.value
+                && first.apart(i, &alone.plan.path, paths, sensors);
+            if again || unmoved {
+                return FirstSearch {
+                    plan: alone.plan.clone(),
+                    upper: if again { alone.upper } else { alone.plan.value },
+                    current: current.map(|_| (alone.plan.value, alone.plan.violations)),
+                };
+            }
+        }
         let mut grid = self.motion(i);
         let cover = first.path_cover_among(i, self.starts[i], paths, sensors, &mut grid);
         mark_too_close(&mut grid, self.starts[i], self.min_separation, avoid);
@@ -281,7 +318,7 @@ impl Fleet<'_> {
             .into_iter()
             .map(|(dc, dr)| self.starts[i].offset(dc, dr))
             .collect();
-        FirstSearch {
+        let found = FirstSearch {
             plan: SensorPlan {
                 path,
                 value: found.best.value,
@@ -290,7 +327,11 @@ impl Fleet<'_> {
             },
             upper: found.upper,
             current,
+        };
+        if sensors.is_empty() && plain {
+            let _ = self.alone[i].set(found.clone());
         }
+        found
     }
 }
 

@@ -548,6 +548,7 @@ impl Chosen<'_> {
         if let Some(first) = &first {
             fleet = fleet.with_first_detections(first);
         }
+        fleet.full_searches = input.explain;
         f(&fleet)
     }
 }

@@ -318,17 +318,68 @@ impl<'e> FirstDetections<'e> {
         for t in 1..=horizon {
             for &q in sensors {
                 let cell = paths[q][t - 1];
-                let cached = self.stops[q].get().and_then(|stops| {
-                    let offset = (cell.col - stops.start.col, cell.row - stops.start.row);
-                    stops.try_stop(t, offset).map(|r| &stops.pieces[r])
-                });
-                match cached {
+                match self.stop_pieces(q, t, cell) {
                     Some(own) => pieces.extend_from_slice(own),
                     None => self.pieces(&s.look(self.est.types[q], cell), t, &mut pieces, &mut buf),
                 }
             }
         }
         pieces
+    }
+
+    /// The pieces of sensor `q`'s look at `cell` at step `t`, if its
+    /// search built them.
+    fn stop_pieces(&self, q: usize, t: usize, cell: Cell) -> Option<&[Piece]> {
+        let stops = self.stops[q].get()?;
+        let offset = (cell.col - stops.start.col, cell.row - stops.start.row);
+        stops.try_stop(t, offset).map(|r| &stops.pieces[r])
+    }
+
+    /// True when no look of `sensors` on `paths` (`paths[q][t − 1]` at
+    /// step `t`) holds a target that a look of sensor `sensor` on `path`
+    /// holds: no piece of theirs meets the span of its pieces on any key.
+    /// `path`'s first detections against those looks are then its first
+    /// detections alone, and no other path of the sensor gains more
+    /// against them than it gains alone. False when `sensor`'s stops are
+    /// not built yet or `path` leaves them.
+    pub fn apart(
+        &self,
+        sensor: usize,
+        path: &[Cell],
+        paths: &[&[Cell]],
+        sensors: &[usize],
+    ) -> bool {
+        let keys = *self.key_start.last().unwrap_or(&0) as usize;
+        let mut span = vec![(f64::INFINITY, f64::NEG_INFINITY); keys];
+        for (t, &cell) in (1..).zip(path) {
+            let Some(mine) = self.stop_pieces(sensor, t, cell) else {
+                return false;
+            };
+            for x in mine {
+                let s = &mut span[x.key as usize];
+                *s = (s.0.min(x.a), s.1.max(x.b));
+            }
+        }
+        let clear = |pieces: &[Piece]| {
+            pieces.iter().all(|e| {
+                let (a, b) = span[e.key as usize];
+                e.b <= a || e.a >= b
+            })
+        };
+        let (s, mut buf, mut made) = (self.est.scenario, PieceScratch::default(), Vec::new());
+        (1..=path.len()).all(|t| {
+            sensors.iter().all(|&q| {
+                let cell = paths[q][t - 1];
+                match self.stop_pieces(q, t, cell) {
+                    Some(theirs) => clear(theirs),
+                    None => {
+                        made.clear();
+                        self.pieces(&s.look(self.est.types[q], cell), t, &mut made, &mut buf);
+                        clear(&made)
+                    }
+                }
+            })
+        })
     }
 
     /// The background of a search: the history, and over it the `pieces`
