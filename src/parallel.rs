@@ -17,3 +17,14 @@ pub(crate) fn min_len() -> usize {
         usize::MAX
     }
 }
+
+/// How many items a plan's parallel loop runs at once: the pool's workers
+/// on a worker of a rayon pool, one elsewhere. A loop that may stop early
+/// takes its items in batches of this many.
+pub(crate) fn width() -> usize {
+    if rayon::current_thread_index().is_some() {
+        rayon::current_num_threads()
+    } else {
+        1
+    }
+}

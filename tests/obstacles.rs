@@ -496,7 +496,6 @@ fn check_path_gains(yard: &Yard) {
     let (mut apart, mut near) = (0, 0);
     for sensor in 0..3 {
         let (start, ty) = (starts[sensor], types[sensor]);
-        let speed = s.types[ty].speed as i32;
         for with_others in [false, true] {
             // The others on their fixed paths, or nobody.
             let extra: Vec<Vec<Look>> = (1..=HORIZON)
@@ -516,18 +515,7 @@ fn check_path_gains(yard: &Yard) {
             assert_eq!(grid, among);
             let background: f64 = first.by_step(&extra).iter().sum();
             for _ in 0..150 {
-                let mut at = start;
-                let mut cells = Vec::new();
-                while cells.len() < HORIZON {
-                    let next = Cell {
-                        col: at.col + rng.random_range(-speed..=speed),
-                        row: at.row + rng.random_range(-speed..=speed),
-                    };
-                    if s.on_lattice(next) && s.is_free(ty, next) {
-                        cells.push(next);
-                        at = next;
-                    }
-                }
+                let cells = random_path(&mut rng, s, start, ty);
                 let offsets: Vec<(i32, i32)> = cells
                     .iter()
                     .map(|c| (c.col - start.col, c.row - start.row))
@@ -570,6 +558,87 @@ fn check_path_gains(yard: &Yard) {
     }
     assert!(multi > 100, "too few paths detect anything: {multi}");
     assert!(apart >= 5 && near >= 5, "{apart} paths apart, {near} near");
+}
+
+/// A random legal path of a sensor of type `ty` from `start` over
+/// [`HORIZON`] steps.
+fn random_path(rng: &mut StdRng, s: &Scenario, start: Cell, ty: usize) -> Vec<Cell> {
+    let speed = s.types[ty].speed as i32;
+    let mut at = start;
+    let mut cells = Vec::new();
+    while cells.len() < HORIZON {
+        let next = Cell {
+            col: at.col + rng.random_range(-speed..=speed),
+            row: at.row + rng.random_range(-speed..=speed),
+        };
+        if s.on_lattice(next) && s.is_free(ty, next) {
+            cells.push(next);
+            at = next;
+        }
+    }
+    cells
+}
+
+/// The first-detections marginal bound stops its searches once it passes
+/// the sum of the solo bests, which is then the smaller bound: the
+/// certificate is the one every search gives, to the bit, for plans of
+/// the yard's three sensors (each on its track's path, its best path
+/// alone or a random one), with and without obstacles.
+#[test]
+fn first_marginal_bound_stops_at_the_same_certificate() {
+    use vigil::coordination::certificate::first_marginal_bound;
+    use vigil::coordination::{Bound, Fleet};
+    use vigil::estimator::FirstDetections;
+    let mut without = yard_spec();
+    without
+        .as_object_mut()
+        .expect("an object")
+        .remove("obstacles");
+    let mut rng = StdRng::seed_from_u64(59);
+    let (mut stopped, mut whole) = (0, 0);
+    for spec in [yard_spec(), without] {
+        let yard = Yard::with_spec(spec, None);
+        let (s, types) = (&yard.s, &yard.types);
+        let observed = yard.observed(HISTORY);
+        let starts = track(0).to_vec();
+        let est = yard.estimator(&observed, &starts, HORIZON);
+        let first = FirstDetections::new(&est);
+        let cancel = CancelToken::never();
+        let fleet =
+            Fleet::new(s, &est, &starts, types, HORIZON, 0, &cancel).with_first_detections(&first);
+        let alone: Vec<_> = (0..3)
+            .map(|i| fleet.first_search(i, &[], &[], Vec::new(), None))
+            .collect();
+        let solo: f64 = alone.iter().map(|a| a.upper).sum();
+        for _ in 0..40 {
+            let cells: Vec<Vec<Cell>> = (0..3)
+                .map(|q| match rng.random_range(0..3) {
+                    0 => (1..=HORIZON).map(|t| path(t)[q]).collect(),
+                    1 => alone[q].plan.path.clone(),
+                    _ => random_path(&mut rng, s, starts[q], types[q]),
+                })
+                .collect();
+            let paths: Vec<&[Cell]> = cells.iter().map(Vec::as_slice).collect();
+            let order = [2, 0, 1];
+            let value: f64 = fleet.by_step(&paths, &order).iter().sum();
+            let every = first_marginal_bound(&fleet, &paths, value, &order, f64::INFINITY).unwrap();
+            let early = first_marginal_bound(&fleet, &paths, value, &order, solo).unwrap();
+            assert_eq!(
+                Bound::new(value, [solo, early]),
+                Bound::new(value, [solo, every])
+            );
+            if early < every {
+                stopped += 1;
+            } else {
+                assert_eq!(early.to_bits(), every.to_bits());
+                whole += 1;
+            }
+        }
+    }
+    assert!(
+        stopped >= 5 && whole >= 5,
+        "stopped {stopped}, whole {whole}"
+    );
 }
 
 /// The vertices' own reader takes back what `Serialize` writes, in JSON

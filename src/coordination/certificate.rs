@@ -98,20 +98,40 @@ pub fn marginal_bound(fleet: &Fleet, paths: &[&[Cell]], value: f64) -> Result<f6
 /// [`Fleet::first_search`]); the same argument holds, the objective being
 /// a coverage of the targets over the whole horizon.
 ///
+/// The searches run in `order` (sensor indices), a batch at a time, and
+/// stop once `value` and the gains so far reach `enough` (the caller's
+/// other bound): every gain is at least 0, so the bound is then at least
+/// `enough`, which is the smaller, and the sum so far is returned.
+///
 /// # Errors
 /// [`Cancelled`] once the fleet's token is cancelled.
 pub fn first_marginal_bound(
     fleet: &Fleet,
     paths: &[&[Cell]],
     value: f64,
+    order: &[usize],
+    enough: f64,
 ) -> Result<f64, Cancelled> {
     let all: Vec<usize> = (0..fleet.len()).collect();
-    let gains: Vec<f64> = (0..fleet.len())
-        .into_par_iter()
-        .with_min_len(crate::parallel::min_len())
-        .map(|i| fleet.first_search(i, paths, &all, Vec::new(), None).upper)
-        .collect();
-    fleet.cancel.check()?;
+    let mut gains = vec![0.0; fleet.len()];
+    let mut so_far = value;
+    for batch in order.chunks(crate::parallel::width()) {
+        if so_far >= enough {
+            return Ok(so_far);
+        }
+        let found: Vec<f64> = batch
+            .par_iter()
+            .with_min_len(crate::parallel::min_len())
+            .map(|&i| fleet.first_search(i, paths, &all, Vec::new(), None).upper)
+            .collect();
+        fleet.cancel.check()?;
+        for (&i, gain) in batch.iter().zip(found) {
+            gains[i] = gain;
+            so_far += gain;
+        }
+    }
+    // Every search made: summed in request order, as a bound that is
+    // the smaller must be.
     Ok(value + gains.iter().sum::<f64>())
 }
 

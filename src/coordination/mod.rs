@@ -234,7 +234,13 @@ pub fn coordinate(
             value,
             [
                 solo_upper,
-                certificate::first_marginal_bound(fleet, &path_slices(&plans), value)?,
+                certificate::first_marginal_bound(
+                    fleet,
+                    &path_slices(&plans),
+                    value,
+                    &order,
+                    solo_upper,
+                )?,
             ],
         ))
     } else if est.order_independent() {
