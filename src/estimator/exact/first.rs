@@ -100,8 +100,8 @@ impl Profile {
 #[derive(Debug, Default)]
 struct PieceScratch {
     buf: Vec<Point>,
-    /// The look's part of each ray of one source: `(ray, lo, hi)`.
-    on_rays: Vec<(u32, f64, f64)>,
+    /// What one look holds of the rays (see [`FirstDetections::held`]).
+    held: Vec<(u32, u32, f64, f64)>,
     visible: Vec<(f64, f64)>,
 }
 
@@ -186,23 +186,29 @@ impl<'e> FirstDetections<'e> {
 
     /// Appends the pieces of `look` taken at step `t`, sorted by key.
     fn pieces(&self, look: &Look, t: usize, out: &mut Vec<Piece>, scratch: &mut PieceScratch) {
-        let PieceScratch {
-            buf,
-            on_rays,
-            visible,
-        } = scratch;
-        // With obstacles, only what the look sees of each ray, before a
-        // building ends the flights along it (see `sighted`).
+        let mut held = std::mem::take(&mut scratch.held);
+        held.clear();
+        self.held(look, &mut held, scratch);
+        self.pieces_at(&held, look.p_detect, t, out);
+        scratch.held = held;
+    }
+
+    /// Appends what `look` holds of each ray, `(source's rays, ray, lo,
+    /// hi)` by source's rays then ray: the part of the ray in its field
+    /// of view, before a building ends the flights along it, and with
+    /// obstacles only what the look sees of it (see `sighted`). The same
+    /// at every step.
+    fn held(&self, look: &Look, out: &mut Vec<(u32, u32, f64, f64)>, scratch: &mut PieceScratch) {
+        let PieceScratch { buf, visible, .. } = scratch;
         let sight = self.est.scenario.sight(look);
         for (ri, sr) in self.est.rays.iter().enumerate() {
-            let classes = self.classes_of_rays[ri].clone();
-            if classes.is_empty() {
+            if self.classes_of_rays[ri].is_empty() {
                 continue;
             }
             let Some((a, b)) = sr.range(&look.region, buf) else {
                 continue;
             };
-            on_rays.clear();
+            let ri = ri as u32;
             for m in a..b {
                 let (d, inv) = sr.dirs[m];
                 let Some((lo, hi)) = look.region.ray(sr.source.pos, d, inv) else {
@@ -210,28 +216,36 @@ impl<'e> FirstDetections<'e> {
                 };
                 let hi = hi.min(sr.stop(m));
                 match &sight {
-                    None if hi > lo => on_rays.push((m as u32, lo, hi)),
+                    None if hi > lo => out.push((ri, m as u32, lo, hi)),
                     None => {}
                     Some(v) => {
                         visible.clear();
                         v.visible(sr.source.pos, d, lo, hi.max(lo), visible);
-                        on_rays.extend(
+                        out.extend(
                             visible
                                 .iter()
                                 .filter(|(p, q)| q > p)
-                                .map(|&(p, q)| (m as u32, p, q)),
+                                .map(|&(p, q)| (ri, m as u32, p, q)),
                         );
                     }
                 }
             }
-            for c in classes {
+        }
+    }
+
+    /// Appends the pieces at step `t` of a look of detection probability
+    /// `p` that holds `held` (see [`FirstDetections::held`]), sorted by
+    /// key: each part pulled back by each class's flight.
+    fn pieces_at(&self, held: &[(u32, u32, f64, f64)], p: f64, t: usize, out: &mut Vec<Piece>) {
+        for same in held.chunk_by(|x, y| x.0 == y.0) {
+            for c in self.classes_of_rays[same[0].0 as usize].clone() {
                 let class = &self.est.classes[c];
                 let shift = class.speed * t as f64;
-                out.extend(on_rays.iter().map(|&(m, lo, hi)| Piece {
+                out.extend(same.iter().map(|&(_, m, lo, hi)| Piece {
                     key: self.key_start[c] + m,
                     a: lo - shift,
                     b: hi - shift,
-                    p: look.p_detect,
+                    p,
                     w: class.weight,
                 }));
             }
@@ -442,13 +456,24 @@ impl<'e> FirstDetections<'e> {
             for t in 1..=horizon {
                 grid.for_each_reachable(t, |_, _| reachable += 1);
             }
+            // What the look at each offset holds of the rays, found at the
+            // first step that reaches it: `held[at[offset]]`.
+            let mut held = Vec::new();
+            let mut at: Vec<Option<std::ops::Range<usize>>> = vec![None; side * side];
+            let p_detect = s.types[ty].p_detect;
             for t in 1..=horizon {
                 grid.for_each_reachable(t, |dc, dr| {
                     let Some(k) = s.lattice_cell(start, dc, dr) else {
                         return;
                     };
                     let first = stops.pieces.len();
-                    self.pieces(&s.look(ty, k), t, &mut stops.pieces, &mut buf);
+                    let offset = (dr + extent) as usize * side + (dc + extent) as usize;
+                    let range = at[offset].get_or_insert_with(|| {
+                        let from = held.len();
+                        self.held(&s.look(ty, k), &mut held, &mut buf);
+                        from..held.len()
+                    });
+                    self.pieces_at(&held[range.clone()], p_detect, t, &mut stops.pieces);
                     if first == 0 {
                         // Room for about as many pieces at every stop as
                         // at the first, at once rather than by growing.
