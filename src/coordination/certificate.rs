@@ -98,10 +98,12 @@ pub fn marginal_bound(fleet: &Fleet, paths: &[&[Cell]], value: f64) -> Result<f6
 /// [`Fleet::first_search`]); the same argument holds, the objective being
 /// a coverage of the targets over the whole horizon.
 ///
-/// The searches run in `order` (sensor indices), a batch at a time, and
-/// stop once `value` and the gains so far reach `enough` (the caller's
-/// other bound): every gain is at least 0, so the bound is then at least
-/// `enough`, which is the smaller, and the sum so far is returned.
+/// The searches run in `order` (every sensor's index once), a batch at a
+/// time, and stop once `value` and the gains so far reach `enough` (the
+/// caller's other bound): every gain is at least 0, so this bound is then
+/// at least `enough`, and the sum so far is returned. It is not a bound
+/// itself then; only the smaller of it and `enough` is, which is
+/// `enough`, as it would have been with every search made.
 ///
 /// # Errors
 /// [`Cancelled`] once the fleet's token is cancelled.
@@ -130,8 +132,8 @@ pub fn first_marginal_bound(
             so_far += gain;
         }
     }
-    // Every search made: summed in request order, as a bound that is
-    // the smaller must be.
+    // Every search made: summed in request order, as before, so that a
+    // bound that is the smaller stays the same to the bit.
     Ok(value + gains.iter().sum::<f64>())
 }
 
