@@ -2,15 +2,17 @@
 //! decide before starting it: a scenario's precomputation (run as a job
 //! past the synchronous budget) and a plan (refused past `--max-plan-ms`).
 //!
-//! Both models are linear, `Σ c_k·x_k`: each term `x_k` counts the work of
+//! The models are linear, `Σ c_k·x_k`: each term `x_k` counts the work of
 //! one stage of the code, read off the scenario or the request without any
-//! estimator work ([`precompute_terms`], [`plan_terms`]); each coefficient
-//! `c_k` is CPU milliseconds per unit on one core ([`PRECOMPUTE_MODEL`],
-//! [`PLAN_MODEL`] hold them; the tables below list the same values).
+//! estimator work ([`precompute_terms`], [`plan_terms`], [`first_terms`]);
+//! each coefficient `c_k` is CPU milliseconds per unit on one core
+//! ([`PRECOMPUTE_MODEL`], [`PLAN_MODEL`] and, for plans that maximise
+//! first detections, [`FIRST_MODEL`] hold them; the tables below list the
+//! same values).
 //!
 //! The coefficients are fitted from timed runs by
 //! `cargo run --release -p vigil-loadtest --example cost_model`, which
-//! prints them in the form of the two tables below; how, on what data, and
+//! prints them in the form of the tables below; how, on what data, and
 //! how well the models predict is in `docs/performance.md` (*The cost
 //! model*). A prediction must stay cheap next to the work it predicts:
 //! O(sources + fields of view) for a precomputation, O(sensors² + targets +
@@ -68,11 +70,31 @@
 //!
 //! The `sighted` coefficient is fitted alone, the others held, on
 //! `site-campus`'s fleets (`--only campus`; `docs/obstacles.md`).
+//!
+//! First detections ([`plan_ms`] with `"objective": "first_detections"`,
+//! whose searches replace the fill and programme above); per sensor `k`
+//! searches: alone, ranked, the certificate's, and `iterated`'s rounds
+//! (`1 + min(7, Ē/4)`):
+//!
+//! | term | c (ms) | counts |
+//! |---|---:|---|
+//! | estimator | 1 (held) | the first seven terms above: seen sets and windows |
+//! | searches: backgrounds | 8.983e-6 | `k × (n − 1) × T × rays per look`: the other sensors' pieces each search merges |
+//! | searches: pair gains × t | 1.991e-6 | `k × Σ_t cells(t − 1) × (2v+1)² × t × rays per look`: a pair into step `t` meets `t` stops' pieces |
+//! | searches: paths within the budget | 1.661e-7 | `k × min((2v+1)^T, budget) × T × rays per look`: the branch and bound past the pairs |
+//! | searches: cells near obstacles | 3.575e-5 | `k × Σ_t cells(t) × rays per look × the share of the reach near an obstacle` (ground sensors) |
+
+mod first;
+mod reach;
+
+pub use first::{FIRST_MODEL, FirstTerms, first_terms};
+use reach::{
+    half, iterated_rounds, near_by_step, obstructed_share, rays_per_look, sensor_reach, source_rays,
+};
 
 use crate::coordination::{Coordination, Objective};
 use crate::estimator::{
     INDEX_CROSSINGS_PER_CELL, MAX_SMALL_GRID, MIN_INDEX_CROSSINGS, ONE_WINDOW_RECTANGLES,
-    SourceRays,
 };
 use crate::geometry::Point;
 use crate::limits::OBSTACLE_STATS_RAYS_PER_PI;
@@ -270,12 +292,15 @@ fn obstacle_rays(s: &Scenario) -> f64 {
 /// ([`Planner::plan`]), milliseconds on one core: positive and finite;
 /// O(sensors² + targets + history) to compute (microseconds).
 pub fn plan_ms(planner: &Planner, input: &PlanInput) -> f64 {
-    let work = dot(&PLAN_MODEL, &plan_terms(planner, input).to_array()).max(FLOOR_MS);
+    let terms = plan_terms(planner, input).to_array();
     if input.objective == Objective::FirstDetections {
         // Its searches, not the model's fill and programme, are the work
         // (and `joint` runs as `iterated`).
-        return work + FIRST_DETECTIONS_MS_PER_PAIR * first_detection_pairs(planner, input);
+        let estimator = dot(&PLAN_MODEL[..ESTIMATOR_TERMS], &terms[..ESTIMATOR_TERMS]);
+        let first = first_terms(planner, input, estimator).to_array();
+        return dot(&FIRST_MODEL, &first).max(FLOOR_MS);
     }
+    let work = dot(&PLAN_MODEL, &terms).max(FLOOR_MS);
     // `joint` may use all of its budget on top of `iterated`'s work.
     match (input.coordination, input.estimator) {
         (Coordination::Joint, EstimatorKind::Exact) => {
@@ -285,32 +310,9 @@ pub fn plan_ms(planner: &Planner, input: &PlanInput) -> f64 {
     }
 }
 
-/// Milliseconds per pair gain of a sensor's reach in a first-detections
-/// plan: a rough one-term model, fitted on the reference workload with
-/// iterated coordination at T = 8 (61,200 pairs). The search leaves out
-/// more of the pairs at short horizons, so it overestimates those (at
-/// T = 3, 3,150 pairs); the figures are in `docs/intrusion.md`. Every
-/// search of a sensor computes the pairs its lone values leave, and the
-/// branch and bound past them grows with them.
-const FIRST_DETECTIONS_MS_PER_PAIR: f64 = 0.0184;
-
-/// The pair gains of every sensor's reach: `(2m+1)²` successors of each
-/// offset a sensor of speed `m` may stand on before each step, the lattice's
-/// edges ignored (an overestimate near them).
-fn first_detection_pairs(planner: &Planner, input: &PlanInput) -> f64 {
-    let s = &planner.scenario;
-    input
-        .types()
-        .iter()
-        .map(|&ty| {
-            let m = s.types[ty].speed as f64;
-            let successors = (2.0 * m + 1.0).powi(2);
-            (0..input.horizon)
-                .map(|t| (2.0 * m * t as f64 + 1.0).powi(2) * successors)
-                .sum::<f64>()
-        })
-        .sum()
-}
+/// The first [`PLAN_MODEL`] terms, up to `fill: cells`: the estimator a
+/// plan builds before its searches (its seen sets and windows).
+pub const ESTIMATOR_TERMS: usize = 7;
 
 /// Milliseconds per crossing of a fit's exposure (a look, a ray of the
 /// scenario's grid that may cross it, a class:
@@ -336,7 +338,7 @@ pub fn fit_ms(s: &Scenario, crossings: usize) -> f64 {
 /// emit nothing), the work never is.
 const FLOOR_MS: f64 = 0.01;
 
-fn dot<const N: usize>(model: &[(&str, f64); N], terms: &[f64; N]) -> f64 {
+fn dot(model: &[(&str, f64)], terms: &[f64]) -> f64 {
     model.iter().zip(terms).map(|((_, c), t)| c * t).sum()
 }
 
@@ -389,36 +391,6 @@ pub fn precompute_terms(s: &Scenario) -> PrecomputeTerms {
     t
 }
 
-/// The share of the cells from `lo` to `hi` (a block) whose square field
-/// of view of half width `h` meets an obstacle's bounding box, from the
-/// boxes grown by `h` (overlaps counted twice, at most 1). O(obstacles).
-fn obstructed_share(s: &Scenario, lo: Cell, hi: Cell, h: f64) -> f64 {
-    let cs = s.cell_size;
-    let reach = crate::geometry::Rect {
-        x0: f64::from(lo.col) * cs,
-        y0: f64::from(lo.row) * cs,
-        x1: f64::from(hi.col + 1) * cs,
-        y1: f64::from(hi.row + 1) * cs,
-    };
-    let covered: f64 = s
-        .obstacles
-        .list()
-        .iter()
-        .map(|ob| {
-            let b = ob.polygon.bbox();
-            crate::geometry::Rect {
-                x0: b.x0 - h,
-                y0: b.y0 - h,
-                x1: b.x1 + h,
-                y1: b.y1 + h,
-            }
-            .intersect(&reach)
-            .area()
-        })
-        .sum();
-    (covered / reach.area()).min(1.0)
-}
-
 /// The share of the angles towards the zone that a source's cone holds
 /// (1 for a half-plane source).
 fn in_cone(s: &Scenario, src: &Source, buf: &mut Vec<Point>) -> f64 {
@@ -451,34 +423,6 @@ fn intervals(n: i32, cell: f64, halves: &[f64]) -> f64 {
     offsets.len() as f64 * n as f64 + 1.0
 }
 
-/// Rays per π of the exact estimator's angular grid on `s`.
-fn density(s: &Scenario) -> f64 {
-    SourceRays::density(s)
-}
-
-/// Per source with targets: its index, its rays and its classes.
-fn source_rays(s: &Scenario) -> Vec<(usize, f64, f64)> {
-    let zone = s.zone_region();
-    let mut buf = Vec::new();
-    s.sources
-        .iter()
-        .enumerate()
-        .filter(|(_, src)| src.rate > 0.0)
-        .filter_map(|(j, src)| {
-            let (lo, hi) = angular_span(src, &zone, &mut buf)?;
-            let rays = SourceRays::count(lo, hi, density(s)) as f64;
-            Some((j, rays, s.classes_of(j).len() as f64))
-        })
-        .collect()
-}
-
-fn half(fov: FovSpec) -> f64 {
-    match fov {
-        FovSpec::Square { half_width } => half_width,
-        FovSpec::Circle { radius } => radius,
-    }
-}
-
 /// The terms of [`PLAN_MODEL`] for `input` on `planner` (for fitting and
 /// checks).
 pub fn plan_terms(planner: &Planner, input: &PlanInput) -> PlanTerms {
@@ -488,21 +432,7 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> PlanTerms {
     let grid = planner.grid.as_ref().filter(|_| exact && s.all_square());
     let rays = source_rays(s);
     let classes = s.classes.len() as f64;
-    // Rays (over classes) that meet one look, averaged over up to eight
-    // sensors' fields of view now (their history lies close by).
-    let mut buf = Vec::new();
-    let sample = n.clamp(1, 8);
-    let mut per_look = 0.0;
-    for k in 0..sample.min(n) {
-        let i = k * n / sample;
-        let region = s.fov_region_of(input.types[i], input.starts[i]);
-        for &(j, _, cl) in &rays {
-            if let Some((lo, hi)) = angular_span(&s.sources[j], &region, &mut buf) {
-                per_look += cl * ((hi - lo) * density(s) / std::f64::consts::PI + 2.0);
-            }
-        }
-    }
-    per_look /= sample as f64;
+    let per_look = rays_per_look(s, input, &rays);
     let all_rays: f64 = rays.iter().map(|r| r.1 * r.2).sum();
     let history: usize = input.history.iter().map(Vec::len).sum();
     let now = match input.observed {
@@ -510,32 +440,9 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> PlanTerms {
         Observed::Sensors => n as f64 * per_look,
     };
     let look_rays = now + history as f64 * per_look;
-
-    // near[i·(T+1) + t]: the sensors whose looks can first meet sensor i's
-    // reach box at step t (starts within both halves and both reaches).
     let stride = big_t + 1;
-    let mut near = vec![0u32; n * stride];
-    let me: Vec<(Cell, f64, f64)> = (input.starts.iter().zip(&input.types))
-        .map(|(&c, &ty)| (c, half(s.types[ty].fov) / cs, s.types[ty].speed as f64))
-        .collect();
-    for (i, &(a, ha, va)) in me.iter().enumerate() {
-        for (q, &(b, hb, vb)) in me.iter().enumerate().skip(i + 1) {
-            let d = (a.col - b.col).abs().max((a.row - b.row).abs()) as f64;
-            // The first step t ≥ 1 with d ≤ ha + hb + (va + vb)·t; a cast
-            // truncates (`ceil` is a libm call without SSE4.1).
-            let steps = (d - ha - hb) / (va + vb);
-            let first = if steps <= 1.0 {
-                1
-            } else {
-                steps as usize + usize::from((steps as usize as f64) < steps)
-            };
-            if first <= big_t {
-                near[i * stride + first] += 1;
-                near[q * stride + first] += 1;
-            }
-        }
-    }
-    let mean_near = near.iter().map(|&c| c as f64).sum::<f64>() / n as f64;
+    let near = near_by_step(s, input);
+    let me = sensor_reach(s, input);
     // Reported targets still in the zone at step t (the estimators drop the
     // others): each leaves at its first crossing of the zone's edge.
     let mut in_zone = vec![0.0; big_t + 2];
@@ -574,11 +481,7 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> PlanTerms {
         t.windows_look_rays = big_t as f64 * look_rays;
         t.windows_rects = (big_t * g.dims().0 * g.dims().1) as f64;
     }
-    let rounds = if exact {
-        1.0 + (mean_near / 10.0).min(4.0)
-    } else {
-        1.0 + (mean_near / 4.0).min(7.0)
-    };
+    let rounds = iterated_rounds(&near, n, exact);
     // (runs, share of the nearby sensors excluded) per pass.
     // An exact plan's certificate takes one more search per sensor, with
     // no exclusion; `joint` is `iterated`'s work (its budget is added in

@@ -238,6 +238,17 @@ pub const FIRST_SEARCH_BUDGET: usize = 20_000;
 /// `docs/intrusion.md`).
 pub const FIRST_SEARCH_BUDGET_LONG: usize = 1_000;
 
+/// The budget of a first-detections search at horizon `horizon`:
+/// `FIRST_SEARCH_BUDGET` up to T = 4 (the search is exact), and
+/// `FIRST_SEARCH_BUDGET_LONG` past it.
+pub fn first_search_budget(horizon: usize) -> usize {
+    if horizon <= 4 {
+        FIRST_SEARCH_BUDGET
+    } else {
+        FIRST_SEARCH_BUDGET_LONG
+    }
+}
+
 impl Fleet<'_> {
     /// Every look of `sensors` on `paths`, per step 1..=T.
     pub fn all_looks(&self, paths: &[&[Cell]], sensors: &[usize]) -> Vec<Vec<Look>> {
@@ -297,12 +308,7 @@ impl Fleet<'_> {
         let mut grid = self.motion(i);
         let cover = first.path_cover_among(i, self.starts[i], paths, sensors, &mut grid);
         mark_too_close(&mut grid, self.starts[i], self.min_separation, avoid);
-        let budget = if self.horizon <= 4 {
-            FIRST_SEARCH_BUDGET
-        } else {
-            FIRST_SEARCH_BUDGET_LONG
-        };
-        let found = best_path_bounded(&grid, &cover, budget);
+        let found = best_path_bounded(&grid, &cover, first_search_budget(self.horizon));
         let current = current.and_then(|path| {
             let moves = path_moves(self.starts[i], path);
             let violations = grid.path_violations(&moves)?;

@@ -79,7 +79,7 @@ use crate::separation::{self, Violations};
 pub use certificate::Bound;
 use certificate::Certifier;
 use fleet::path_slices;
-pub use fleet::{Fleet, SensorPlan, path_moves, sensor_motion};
+pub use fleet::{Fleet, SensorPlan, first_search_budget, path_moves, sensor_motion};
 pub use joint::{JointReport, JointSettings};
 pub use priority::MAX_REPAIRS;
 use priority::Ranking;

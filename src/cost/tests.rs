@@ -81,6 +81,46 @@ fn first_detections_are_predicted_by_their_searches() {
     increasing("first detections by horizon", [3, 5, 8].map(first));
 }
 
+/// A first-detections plan is predicted by its searches: fewer searches
+/// (no certificate, no coordination) cost less and best-response rounds
+/// more; more sensors cost more; and ground sensors near buildings pay
+/// for the parts of their looks that the walls hide.
+#[test]
+fn first_detections_follow_their_searches() {
+    let p = Planner::new(builtins().remove(0));
+    let first = |c: Coordination, certify: bool, n: usize| {
+        let mut req = request(&p.scenario, n, 3, 30, 16);
+        req.objective = Some(Objective::FirstDetections);
+        req.certify = Some(certify);
+        plan_cost(&p, req, c)
+    };
+    increasing(
+        "first detections by searches",
+        [
+            first(Coordination::None, false, 10),
+            first(Priority, false, 10),
+            first(Priority, true, 10),
+            first(Iterated, true, 10),
+        ],
+    );
+    increasing(
+        "first detections by sensors",
+        [4, 10, 40].map(|n| first(Priority, true, n)),
+    );
+    let campus = Planner::new(builtins().remove(4));
+    let input = |req: &PlanRequest| PlanInput::new(&campus.scenario, req).expect("valid");
+    let mut req = request(&campus.scenario, 6, 3, 0, 4);
+    req.objective = Some(Objective::FirstDetections);
+    let robots = first_terms(&campus, &input(&req), 0.0);
+    assert!(robots.sighted > 0.0, "{robots:?}");
+    let drones = input(&req);
+    let drones = PlanInput {
+        types: vec![campus.scenario.type_index("drone").expect("a drone type"); 6],
+        ..drones
+    };
+    assert_eq!(first_terms(&campus, &drones, 0.0).sighted, 0.0);
+}
+
 fn increasing(what: &str, costs: impl IntoIterator<Item = f64>) {
     let costs: Vec<f64> = costs.into_iter().collect();
     assert!(costs.windows(2).all(|w| w[1] > w[0]), "{what}: {costs:?}");
