@@ -24,6 +24,7 @@
 //! certificate's marginal bound holds for it.
 
 use super::ExactEstimator;
+use super::rays::{SourceRays, look_key};
 use std::cell::RefCell;
 use std::sync::{Arc, Mutex, OnceLock};
 
@@ -50,13 +51,29 @@ struct Piece {
 /// (or, for a search, detected or counted by another sensor).
 #[derive(Debug, Default)]
 struct Profile {
-    /// `pieces[start[i]..start[i + 1]]` belong to the `i`-th key listed.
+    /// `ends[start[i]..start[i + 1]]` belong to the `i`-th key listed.
     start: Vec<u32>,
-    pieces: Vec<(f64, f64, f64)>,
-    /// Aligned with `pieces`: `Σ (x1 − x0)·detected` of the key's earlier
-    /// pieces.
-    before: Vec<f64>,
+    /// Each piece's end `x1`, apart so that [`Profile::upto`]'s search
+    /// reads only them.
+    ends: Vec<f64>,
+    /// Aligned with `ends`: the rest of each piece, together so that the
+    /// search's answer is one read.
+    known: Vec<Known>,
 }
+
+/// A piece of a [`Profile`] but its end: its start, its detection
+/// probability, and `Σ (x1 − x0)·detected` of its key's earlier pieces.
+#[derive(Debug, Clone, Copy)]
+struct Known {
+    x0: f64,
+    detected: f64,
+    before: f64,
+}
+
+/// Pieces of a key up to which [`Profile::upto`] counts the ends before
+/// its point instead of bisecting them: a count is a scan without
+/// branches, a bisection a chain of dependent loads and mispredictions.
+const SCAN_PIECES: usize = 32;
 
 impl Profile {
     /// Appends one key's sorted disjoint pieces.
@@ -66,30 +83,46 @@ impl Profile {
         }
         let mut acc = 0.0;
         for (x0, x1, d) in pieces {
-            self.pieces.push((x0, x1, d));
-            self.before.push(acc);
+            self.ends.push(x1);
+            self.known.push(Known {
+                x0,
+                detected: d,
+                before: acc,
+            });
             acc += (x1 - x0) * d;
         }
-        self.start.push(self.pieces.len() as u32);
+        self.start.push(self.ends.len() as u32);
     }
 
-    /// The `i`-th key's pieces.
-    fn of(&self, i: usize) -> &[(f64, f64, f64)] {
-        &self.pieces[self.start[i] as usize..self.start[i + 1] as usize]
+    /// Room for `n` more pieces.
+    fn reserve(&mut self, n: usize) {
+        self.ends.reserve(n);
+        self.known.reserve(n);
+    }
+
+    /// The `i`-th key's pieces, `(x0, x1, detected)`.
+    fn of(&self, i: usize) -> impl Iterator<Item = (f64, f64, f64)> + '_ {
+        let (lo, hi) = (self.start[i] as usize, self.start[i + 1] as usize);
+        (self.known[lo..hi].iter().zip(&self.ends[lo..hi])).map(|(k, &x1)| (k.x0, x1, k.detected))
     }
 
     /// `∫_{−∞}^x detected` over the `i`-th key's pieces.
     fn upto(&self, i: usize, x: f64) -> f64 {
         let (lo, hi) = (self.start[i] as usize, self.start[i + 1] as usize);
-        let pieces = &self.pieces[lo..hi];
-        // The first piece that ends after x.
-        let j = pieces.partition_point(|p| p.1 <= x);
-        match pieces.get(j) {
-            Some(&(x0, _, d)) if x > x0 => self.before[lo + j] + (x - x0) * d,
-            Some(_) => self.before[lo + j],
-            None => pieces
-                .last()
-                .map_or(0.0, |&(x0, x1, d)| self.before[hi - 1] + (x1 - x0) * d),
+        // The first piece that ends after x: the ends are sorted, so it
+        // follows the ends at or before x.
+        let ends = &self.ends[lo..hi];
+        let j = if ends.len() <= SCAN_PIECES {
+            ends.iter().filter(|&&e| e <= x).count()
+        } else {
+            ends.partition_point(|&e| e <= x)
+        };
+        match self.known[lo..hi].get(j) {
+            Some(k) if x > k.x0 => k.before + (x - k.x0) * k.detected,
+            Some(k) => k.before,
+            None => self.known[lo..hi].last().map_or(0.0, |k| {
+                k.before + (ends[ends.len() - 1] - k.x0) * k.detected
+            }),
         }
     }
 }
@@ -201,33 +234,46 @@ impl<'e> FirstDetections<'e> {
     fn held(&self, look: &Look, out: &mut Vec<(u32, u32, f64, f64)>, scratch: &mut PieceScratch) {
         let PieceScratch { buf, visible, .. } = scratch;
         let sight = self.est.scenario.sight(look);
+        let key = look_key(self.est.scenario, &look.region);
+        let mut hold = |ri: u32, sr: &SourceRays, m: usize, lo: f64, hi: f64| {
+            let hi = hi.min(sr.stop(m));
+            match &sight {
+                None if hi > lo => out.push((ri, m as u32, lo, hi)),
+                None => {}
+                Some(v) => {
+                    visible.clear();
+                    v.visible(sr.source.pos, sr.dirs[m].0, lo, hi.max(lo), visible);
+                    out.extend(
+                        visible
+                            .iter()
+                            .filter(|(p, q)| q > p)
+                            .map(|&(p, q)| (ri, m as u32, p, q)),
+                    );
+                }
+            }
+        };
         for (ri, sr) in self.est.rays.iter().enumerate() {
             if self.classes_of_rays[ri].is_empty() {
+                continue;
+            }
+            // An indexed look's intervals are read, to the same bits (as
+            // the seen sets read them); a ray that misses has `lo > hi`.
+            if let (Some(key), Some(table)) = (key, &sr.looks) {
+                let (a, stored) = table.of(key);
+                for (m, &(lo, hi)) in (a..).zip(stored) {
+                    if lo <= hi {
+                        hold(ri as u32, sr, m, lo, hi);
+                    }
+                }
                 continue;
             }
             let Some((a, b)) = sr.range(&look.region, buf) else {
                 continue;
             };
-            let ri = ri as u32;
             for m in a..b {
                 let (d, inv) = sr.dirs[m];
-                let Some((lo, hi)) = look.region.ray(sr.source.pos, d, inv) else {
-                    continue;
-                };
-                let hi = hi.min(sr.stop(m));
-                match &sight {
-                    None if hi > lo => out.push((ri, m as u32, lo, hi)),
-                    None => {}
-                    Some(v) => {
-                        visible.clear();
-                        v.visible(sr.source.pos, d, lo, hi.max(lo), visible);
-                        out.extend(
-                            visible
-                                .iter()
-                                .filter(|(p, q)| q > p)
-                                .map(|&(p, q)| (ri, m as u32, p, q)),
-                        );
-                    }
+                if let Some((lo, hi)) = look.region.ray(sr.source.pos, d, inv) {
+                    hold(ri as u32, sr, m, lo, hi);
                 }
             }
         }
@@ -284,8 +330,7 @@ impl<'e> FirstDetections<'e> {
             intervals.extend(
                 self.history
                     .of(key)
-                    .iter()
-                    .filter(|&&(x0, x1, _)| x1 > lo && x0 < hi),
+                    .filter(|&(x0, x1, _)| x1 > lo && x0 < hi),
             );
             let mut prev = detection_within(&intervals, lo, hi, &mut events);
             let mut taken = 0;
@@ -405,15 +450,14 @@ impl<'e> FirstDetections<'e> {
         merged.start.push(0);
         // About as many pieces as the extra looks' and the history's on
         // their keys: reserved at once, not grown.
-        merged.pieces.reserve(2 * pieces.len());
-        merged.before.reserve(2 * pieces.len());
+        merged.reserve(2 * pieces.len());
         let mut intervals: Vec<(f64, f64, f64)> = Vec::new();
         let mut events = Vec::new();
         let mut out = Vec::new();
         for group in pieces.chunk_by(|x, y| x.key == y.key) {
             let key = group[0].key;
             intervals.clear();
-            intervals.extend(self.history.of(key as usize).iter().copied());
+            intervals.extend(self.history.of(key as usize));
             intervals.extend(group.iter().map(|p| (p.a, p.b, p.p)));
             let lo = intervals.iter().map(|x| x.0).fold(f64::INFINITY, f64::min);
             let hi = intervals
@@ -452,35 +496,51 @@ impl<'e> FirstDetections<'e> {
                 per_key: 1,
             };
             let mut buf = PieceScratch::default();
-            let mut reachable = 0;
-            for t in 1..=horizon {
-                grid.for_each_reachable(t, |_, _| reachable += 1);
-            }
+            // Offsets reachable by the last step: every offset's look once.
+            let mut offsets = 0;
+            grid.for_each_reachable(horizon, |_, _| offsets += 1);
             // What the look at each offset holds of the rays, found at the
-            // first step that reaches it: `held[at[offset]]`.
+            // first step that reaches it (`held[at[offset]]`), and how many
+            // pieces it makes at each step: all of them first, so that the
+            // stops' pieces take their room at once rather than by growing.
             let mut held = Vec::new();
-            let mut at: Vec<Option<std::ops::Range<usize>>> = vec![None; side * side];
-            let p_detect = s.types[ty].p_detect;
+            let mut at: Vec<Option<(std::ops::Range<usize>, usize)>> = vec![None; side * side];
+            let mut total = 0;
             for t in 1..=horizon {
                 grid.for_each_reachable(t, |dc, dr| {
                     let Some(k) = s.lattice_cell(start, dc, dr) else {
                         return;
                     };
-                    let first = stops.pieces.len();
                     let offset = (dr + extent) as usize * side + (dc + extent) as usize;
-                    let range = at[offset].get_or_insert_with(|| {
+                    let (_, pieces) = at[offset].get_or_insert_with(|| {
                         let from = held.len();
                         self.held(&s.look(ty, k), &mut held, &mut buf);
-                        from..held.len()
+                        if from == 0 {
+                            held.reserve(held.len() * offsets);
+                        }
+                        let pieces = held[from..]
+                            .iter()
+                            .map(|h| self.classes_of_rays[h.0 as usize].len())
+                            .sum();
+                        (from..held.len(), pieces)
                     });
-                    self.pieces_at(&held[range.clone()], p_detect, t, &mut stops.pieces);
-                    if first == 0 {
-                        // Room for about as many pieces at every stop as
-                        // at the first, at once rather than by growing.
-                        let more = stops.pieces.len() * reachable;
-                        stops.pieces.reserve(more);
-                        stops.history_ends.reserve(more);
+                    total += *pieces;
+                });
+            }
+            stops.pieces.reserve_exact(total);
+            stops.history_ends.reserve_exact(total);
+            let p_detect = s.types[ty].p_detect;
+            for t in 1..=horizon {
+                grid.for_each_reachable(t, |dc, dr| {
+                    if s.lattice_cell(start, dc, dr).is_none() {
+                        return;
                     }
+                    let first = stops.pieces.len();
+                    let offset = (dr + extent) as usize * side + (dc + extent) as usize;
+                    let Some((range, _)) = &at[offset] else {
+                        return;
+                    };
+                    self.pieces_at(&held[range.clone()], p_detect, t, &mut stops.pieces);
                     stops
                         .history_ends
                         .extend(stops.pieces[first..].iter().map(|p| {
