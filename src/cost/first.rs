@@ -10,13 +10,13 @@ use crate::coordination::{Coordination, first_search_budget};
 use crate::planner::{PlanInput, Planner};
 use crate::scenario::Cell;
 
-/// The first-detections plan model ([`plan_ms`](super::plan_ms) of a plan with
-/// `"objective": "first_detections"`): each term's name and coefficient,
-/// milliseconds per unit, in the order of [`FirstTerms`]. The estimator's
-/// coefficient is held at 1 ([`PLAN_MODEL`](super::PLAN_MODEL) predicts that work; it is a
-/// few percent of these plans, and a free fit gives it 0); the others are
-/// fitted like [`PLAN_MODEL`](super::PLAN_MODEL)'s, on first-detections plans alone
-/// (`--only first`).
+/// The first-detections plan model ([`plan_ms`](super::plan_ms) of a
+/// plan with `"objective": "first_detections"`): each term's name and
+/// coefficient, milliseconds per unit, in the order of [`FirstTerms`]. The
+/// estimator's coefficient is held at 1 ([`PLAN_MODEL`](super::PLAN_MODEL)
+/// predicts that work; it is a few percent of these plans, and a free fit
+/// gives it 0); the others are fitted like `PLAN_MODEL`'s, on
+/// first-detections plans alone (`--only first`).
 pub const FIRST_MODEL: [(&str, f64); 5] = [
     ("estimator (PLAN_MODEL's seen and windows)", 1.0),
     ("searches: backgrounds, n × T × rays per look", 8.983e-6),
@@ -34,8 +34,9 @@ pub const FIRST_MODEL: [(&str, f64); 5] = [
 /// The units of work of one first-detections plan, one per term of
 /// [`FIRST_MODEL`] (same order). Per sensor, `k` searches (alone, ranked,
 /// the certificate's, and `iterated`'s rounds, counted as for the paper
-/// estimator in [`PLAN_MODEL`](super::PLAN_MODEL)). Each search reads the sensor's stops
-/// (every reachable cell at every step, a piece per ray its look meets)
+/// estimator in [`PLAN_MODEL`](super::PLAN_MODEL)). Each search reads the
+/// sensor's stops (every reachable cell at every step, a piece per ray its
+/// look meets)
 /// against a background of the other sensors' looks, computes the gains
 /// of pairs of consecutive stops (a pair into step `t` meets `t` stops'
 /// pieces) and at most its budget of gains past them
@@ -43,8 +44,9 @@ pub const FIRST_MODEL: [(&str, f64); 5] = [
 /// its visible parts.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct FirstTerms {
-    /// The [`PLAN_MODEL`](super::PLAN_MODEL) prediction of the estimator the plan builds
-    /// ([`ESTIMATOR_TERMS`](super::ESTIMATOR_TERMS)) (`FIRST_MODEL[0]`).
+    /// The [`PLAN_MODEL`](super::PLAN_MODEL) prediction of the estimator
+    /// the plan builds ([`ESTIMATOR_TERMS`](super::ESTIMATOR_TERMS))
+    /// (`FIRST_MODEL[0]`).
     pub estimator: f64,
     /// searches: backgrounds, n × T × rays per look (`FIRST_MODEL[1]`).
     pub backgrounds: f64,
@@ -72,7 +74,8 @@ impl FirstTerms {
 }
 
 /// The terms of [`FIRST_MODEL`] for `input` on `planner`, `estimator`
-/// being the [`PLAN_MODEL`](super::PLAN_MODEL) prediction of its first [`ESTIMATOR_TERMS`](super::ESTIMATOR_TERMS).
+/// being the [`PLAN_MODEL`](super::PLAN_MODEL) prediction of its first
+/// [`ESTIMATOR_TERMS`](super::ESTIMATOR_TERMS).
 pub fn first_terms(planner: &Planner, input: &PlanInput, estimator: f64) -> FirstTerms {
     let s = &planner.scenario;
     let (n, big_t) = (input.starts.len(), input.horizon);

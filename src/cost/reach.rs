@@ -37,7 +37,7 @@ pub(super) fn obstructed_share(s: &Scenario, lo: Cell, hi: Cell, h: f64) -> f64 
 }
 
 /// Rays per π of the exact estimator's angular grid on `s`.
-pub(super) fn density(s: &Scenario) -> f64 {
+fn density(s: &Scenario) -> f64 {
     SourceRays::density(s)
 }
 
@@ -57,6 +57,7 @@ pub(super) fn source_rays(s: &Scenario) -> Vec<(usize, f64, f64)> {
         .collect()
 }
 
+/// A field of view's half width (a square) or radius (a circle).
 pub(super) fn half(fov: FovSpec) -> f64 {
     match fov {
         FovSpec::Square { half_width } => half_width,
