@@ -146,8 +146,17 @@ fn predictions_are_finite_and_positive() {
                 let input = PlanInput::new(&p.scenario, &req).expect("valid");
                 let terms = plan_terms(&p, &input).to_array();
                 assert!(terms.iter().all(|t| t.is_finite() && *t >= 0.0));
-                let ms = plan_cost(&p, req, c);
+                let ms = plan_cost(&p, req.clone(), c);
                 assert!(ms.is_finite() && ms > 0.0, "{}: {ms}", p.scenario.id);
+                if estimator == EstimatorKind::Exact {
+                    let mut req = req;
+                    req.objective = Some(Objective::FirstDetections);
+                    let input = PlanInput::new(&p.scenario, &req).expect("valid");
+                    let terms = first_terms(&p, &input, 0.0).to_array();
+                    assert!(terms.iter().all(|t| t.is_finite() && *t >= 0.0));
+                    let ms = plan_cost(&p, req, c);
+                    assert!(ms.is_finite() && ms > 0.0, "{}: first {ms}", p.scenario.id);
+                }
             }
         }
     }
