@@ -81,6 +81,25 @@ fn first_detections_are_predicted_by_their_searches() {
     increasing("first detections by horizon", [3, 5, 8].map(first));
 }
 
+/// `ESTIMATOR_TERMS` names the constant and the seen-set and window terms
+/// of `PLAN_MODEL`, the estimator a first-detections plan builds too.
+#[test]
+fn the_estimator_terms_are_the_seen_sets_and_windows() {
+    let (estimator, rest) = PLAN_MODEL.split_at(ESTIMATOR_TERMS);
+    assert_eq!(estimator[0].0, "1");
+    assert!(
+        estimator[1..]
+            .iter()
+            .all(|(name, _)| name.starts_with("seen:") || name.starts_with("windows:")),
+        "{estimator:?}"
+    );
+    assert!(
+        rest.iter()
+            .all(|(name, _)| !name.starts_with("seen:") && !name.starts_with("windows:")),
+        "{rest:?}"
+    );
+}
+
 /// A first-detections plan is predicted by its searches: fewer searches
 /// (no certificate, no coordination) cost less and best-response rounds
 /// more; more sensors cost more; and ground sensors near buildings pay
