@@ -99,7 +99,7 @@ use crate::estimator::{
 use crate::geometry::Point;
 use crate::limits::OBSTACLE_STATS_RAYS_PER_PI;
 use crate::planner::{EstimatorKind, Observed, PlanInput, Planner};
-use crate::scenario::{Cell, FovSpec, Scenario, Source};
+use crate::scenario::{FovSpec, Scenario, Source};
 use crate::stats::{ESCAPE_SAMPLES, angular_span};
 
 /// The precompute model: each term's name and coefficient, milliseconds
@@ -508,7 +508,6 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> PlanTerms {
     let mut bbox = vec![(usize::MAX, 0, usize::MAX, 0); stride];
     let (mut total, mut blocks) = (vec![0.0; stride], vec![0.0; stride]);
     let mut fov_rects = 0.0;
-    let cell = |col, row| Cell { col, row };
     for (i, &(start, _, _)) in me.iter().enumerate() {
         let ty = &s.types[input.types[i]];
         let side = 2.0 * half(ty.fov);
@@ -537,11 +536,7 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> PlanTerms {
                 *m *= b.powi(fresh as i32);
             }
             let r = (ty.speed * step) as i32;
-            let lo = cell((start.col - r).max(0), (start.row - r).max(0));
-            let hi = cell(
-                (start.col + r).min(s.cols - 1),
-                (start.row + r).min(s.rows - 1),
-            );
+            let (lo, hi) = s.reach_corners(start, r);
             let cells = ((hi.col - lo.col + 1) * (hi.row - lo.row + 1)) as f64;
             let (rects, rows) = grid.map_or((0.0, 1.0), |g| {
                 let ((a0, _, b0, _), (_, a1, _, b1)) =

@@ -264,21 +264,9 @@ impl<'f, 'a> Relaxation<'f, 'a> {
         for (t0, el) in steps.iter().enumerate() {
             let t = t0 + 1;
             let mut mask = vec![false; el.mass.len()];
-            let last = Cell {
-                col: s.cols - 1,
-                row: s.rows - 1,
-            };
             for i in 0..fleet.len() {
                 let ty = &s.types[fleet.types[i]];
-                let (start, r) = (fleet.starts[i], (ty.speed * t) as i32);
-                let lo = Cell {
-                    col: (start.col - r).max(0),
-                    row: (start.row - r).max(0),
-                };
-                let hi = Cell {
-                    col: (start.col + r).min(last.col),
-                    row: (start.row + r).min(last.row),
-                };
+                let (lo, hi) = s.reach_corners(fleet.starts[i], (ty.speed * t) as i32);
                 let ((a0, _, b0, _), (_, a1, _, b1)) =
                     (el.block(ty.fov_slot, lo), el.block(ty.fov_slot, hi));
                 for b in b0..b1 {

@@ -8,7 +8,6 @@ use super::reach::{
 };
 use crate::coordination::{Coordination, first_search_budget};
 use crate::planner::{PlanInput, Planner};
-use crate::scenario::Cell;
 
 /// The first-detections plan model ([`plan_ms`](super::plan_ms) of a
 /// plan with `"objective": "first_detections"`): each term's name and
@@ -99,15 +98,7 @@ pub fn first_terms(planner: &Planner, input: &PlanInput, estimator: f64) -> Firs
         let ty = &s.types[ty];
         let successors = ((2 * ty.speed + 1) as f64).powi(2);
         let reach = |step: usize| {
-            let r = (ty.speed * step) as i32;
-            let lo = Cell {
-                col: (start.col - r).max(0),
-                row: (start.row - r).max(0),
-            };
-            let hi = Cell {
-                col: (start.col + r).min(s.cols - 1),
-                row: (start.row + r).min(s.rows - 1),
-            };
+            let (lo, hi) = s.reach_corners(start, (ty.speed * step) as i32);
             (
                 lo,
                 hi,

@@ -5,7 +5,7 @@
 use super::*;
 use crate::coordination::Coordination::{Iterated, Priority};
 use crate::planner::PlanRequest;
-use crate::scenario::{SourceSpec, builtins, paper_spec};
+use crate::scenario::{Cell, SourceSpec, builtins, paper_spec};
 use serde_json::json;
 
 /// `n` sensors on a near-square grid (each on the first free cell of

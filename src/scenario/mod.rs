@@ -539,6 +539,22 @@ impl Scenario {
         c.col >= 0 && c.row >= 0 && c.col < self.cols && c.row < self.rows
     }
 
+    /// The lowest and highest corners of the block of lattice cells at most
+    /// `r` cells from `start` along each axis (where a sensor of speed `v`
+    /// can be after `r / v` steps), clipped to the lattice.
+    #[inline]
+    pub fn reach_corners(&self, start: Cell, r: i32) -> (Cell, Cell) {
+        let lo = Cell {
+            col: (start.col - r).max(0),
+            row: (start.row - r).max(0),
+        };
+        let hi = Cell {
+            col: (start.col + r).min(self.cols - 1),
+            row: (start.row + r).min(self.rows - 1),
+        };
+        (lo, hi)
+    }
+
     /// The cell `(dc, dr)` away from `start`, if it lies on the lattice.
     #[inline]
     pub fn lattice_cell(&self, start: Cell, dc: i32, dr: i32) -> Option<Cell> {

@@ -576,21 +576,9 @@ impl<'a> ExactEstimator<'a> {
     ) -> super::elementary::Block {
         let s = self.scenario;
         let ty = &s.types[self.types[sensor]];
-        let ti = (ty.speed * t) as i32;
-        let (lo, _, blo, _) = grid.span(
-            ty.fov_slot,
-            Cell {
-                col: (start.col - ti).max(0),
-                row: (start.row - ti).max(0),
-            },
-        );
-        let (_, hi, _, bhi) = grid.span(
-            ty.fov_slot,
-            Cell {
-                col: (start.col + ti).min(s.cols - 1),
-                row: (start.row + ti).min(s.rows - 1),
-            },
-        );
+        let (first, last) = s.reach_corners(start, (ty.speed * t) as i32);
+        let (lo, _, blo, _) = grid.span(ty.fov_slot, first);
+        let (_, hi, _, bhi) = grid.span(ty.fov_slot, last);
         (lo, hi, blo, bhi)
     }
 

@@ -62,16 +62,8 @@ impl StepWindows {
             .iter()
             .zip(types)
             .map(|(start, &ty)| {
-                let ti = (s.types[ty].speed * t) as i32;
                 let slot = s.types[ty].fov_slot;
-                let lo = Cell {
-                    col: (start.col - ti).max(0),
-                    row: (start.row - ti).max(0),
-                };
-                let hi = Cell {
-                    col: (start.col + ti).min(s.cols - 1),
-                    row: (start.row + ti).min(s.rows - 1),
-                };
+                let (lo, hi) = s.reach_corners(*start, (s.types[ty].speed * t) as i32);
                 let (a0, _, b0, _) = grid.span(slot, lo);
                 let (_, a1, _, b1) = grid.span(slot, hi);
                 (a0, a1, b0, b1)
