@@ -462,24 +462,26 @@ impl Session {
         self.history.len()
     }
 
-    /// Approximate heap memory held, bytes (its planner, shared, aside).
+    /// Approximate heap memory held, bytes (its planner, shared, aside):
+    /// counted from what it holds, not from its buffers' capacity, so that
+    /// every replica reports the same for the same state.
     pub fn memory_bytes(&self) -> usize {
         let positions: usize = self
             .history
             .iter()
             .map(|step| {
-                step.capacity() * std::mem::size_of::<PositionIn>()
+                std::mem::size_of_val(step.as_slice())
                     + step
                         .iter()
                         .filter_map(|p| p.sensor_type.as_ref())
-                        .map(String::capacity)
+                        .map(String::len)
                         .sum::<usize>()
             })
             .sum();
         std::mem::size_of::<Self>()
-            + self.history.capacity() * std::mem::size_of::<Vec<PositionIn>>()
+            + self.history.len() * std::mem::size_of::<Vec<PositionIn>>()
             + positions
-            + self.tracks.capacity() * std::mem::size_of::<Track>()
+            + std::mem::size_of_val(self.tracks.as_slice())
             + self.learner.as_ref().map_or(0, |l| l.memory_bytes())
     }
 

@@ -198,7 +198,7 @@ impl RateLearner {
 
     /// Approximate heap memory held, bytes (the planners aside).
     pub fn memory_bytes(&self) -> usize {
-        let looks: usize = self.recent.iter().map(|l| l.capacity()).sum();
+        let looks: usize = self.recent.iter().map(|l| l.len()).sum();
         looks * std::mem::size_of::<Look>()
             + self.book.len() * 64
             + self.attribution.shared.len() * 48
