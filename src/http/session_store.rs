@@ -30,6 +30,17 @@ use crate::session::{Session, Snapshot};
 use crate::store::PgStore;
 use crate::store::sessions::NewSession;
 
+/// What every session id starts with; 32 hexadecimal digits follow.
+const SESSION_ID_PREFIX: &str = "ss-";
+
+/// Whether `id` has the form of the ids [`SessionStore::create`] makes:
+/// any other names no session, and is not looked up (nor cached, nor sent
+/// to the database, which refuses some bytes).
+fn is_session_id(id: &str) -> bool {
+    id.strip_prefix(SESSION_ID_PREFIX)
+        .is_some_and(|hex| hex.len() == 32 && hex.bytes().all(|b| b.is_ascii_hexdigit()))
+}
+
 /// A session shared by its requests on this replica; its steps here run
 /// one at a time.
 pub type Shared = Arc<tokio::sync::Mutex<Held>>;
@@ -239,7 +250,7 @@ impl SessionStore {
     /// # Errors
     /// [`ApiError::DatabaseUnavailable`] if the database cannot store it.
     pub async fn create(&self, session: Session) -> Result<(String, Shared), ApiError> {
-        let id = format!("ss-{}", uuid::Uuid::new_v4().simple());
+        let id = format!("{SESSION_ID_PREFIX}{}", uuid::Uuid::new_v4().simple());
         if let Some(db) = &self.db {
             let snapshot = session.snapshot();
             let spec = encode_spec(session.planner())?;
@@ -280,6 +291,9 @@ impl SessionStore {
     /// [`ApiError::SessionNotFound`] in memory for an unknown, expired or
     /// evicted id.
     pub fn checkout(&self, id: &str) -> Result<Shared, ApiError> {
+        if !is_session_id(id) {
+            return Err(self.not_found(id));
+        }
         let now = Instant::now();
         let mut map = self.lock();
         self.sweep(&mut map, now);
@@ -318,6 +332,11 @@ impl SessionStore {
         resolve: impl AsyncFnOnce(String, Vec<u8>) -> Result<Arc<Planner>, ApiError>,
     ) -> Result<Refreshed<'a>, ApiError> {
         let cached = held.session.is_some() && !held.stale;
+        // A retry of the last step made here: in the database, another
+        // replica may have stepped, deleted or expired the session since,
+        // so the row decides whether to replay (and a replay is a use).
+        let retry = key.is_some_and(|k| held.last.as_ref().is_some_and(|(last, ..)| last == k.key));
+        let touch = touch || retry;
         let Some(db) = self.db.as_ref().filter(|_| touch || !cached || held.shared) else {
             // In memory, or a cached state that no other replica moved on
             // lately: the step is made from it, and its compare-and-set
@@ -452,6 +471,30 @@ impl SessionStore {
         Ok(stored)
     }
 
+    /// Marks session `id` (from [`SessionStore::checkout`]) used now, as
+    /// any request to it does, for a request refused before its session
+    /// was read: in the database, a session that is not live is then
+    /// not found (and not kept in the cache), as in memory, where
+    /// `checkout` found that out.
+    ///
+    /// # Errors
+    /// [`ApiError::SessionNotFound`] if the session is not live;
+    /// [`ApiError::DatabaseUnavailable`].
+    pub async fn confirm(&self, id: &str) -> Result<(), ApiError> {
+        let Some(db) = &self.db else {
+            return Ok(());
+        };
+        if db.touch_session(id, self.ttl).await? {
+            return Ok(());
+        }
+        self.forget(id);
+        if db.drop_expired_session(id, self.ttl).await.unwrap_or(false) {
+            metrics::counter!(metric_names::SESSIONS_EVICTED_TOTAL, "reason" => "idle")
+                .increment(1);
+        }
+        Err(self.not_found(id))
+    }
+
     /// Marks session `id` used now (after a step that failed, which
     /// stored nothing), in the background; nothing to do in memory.
     pub fn touch(&self, id: &str) {
@@ -469,6 +512,9 @@ impl SessionStore {
     /// [`ApiError::SessionNotFound`] for an unknown, expired or evicted id;
     /// [`ApiError::DatabaseUnavailable`].
     pub async fn remove(&self, id: &str) -> Result<(), ApiError> {
+        if !is_session_id(id) {
+            return Err(self.not_found(id));
+        }
         let Some(db) = &self.db else {
             let mut map = self.lock();
             self.sweep(&mut map, Instant::now());

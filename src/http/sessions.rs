@@ -231,9 +231,20 @@ pub async fn step(
     body: Result<QueuedJson<StepRequest>, ApiError>,
 ) -> Result<Response, ApiError> {
     let shared = state.sessions.checkout(&id)?;
-    let key = idempotency_key(&headers)?;
-    let QueuedJson(req) = body?;
-    req.check()?;
+    let checked = idempotency_key(&headers).and_then(|key| {
+        let QueuedJson(req) = body?;
+        req.check()?;
+        Ok((key, req))
+    });
+    let (key, req) = match checked {
+        Ok(checked) => checked,
+        Err(e) => {
+            // An unknown session is not found whatever the request, and a
+            // refused step still counts as a use of a live one.
+            state.sessions.confirm(&id).await?;
+            return Err(e);
+        }
+    };
     let key = key.map(|key| StepKey {
         key,
         digest: req.digest(),

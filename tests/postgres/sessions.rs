@@ -319,3 +319,56 @@ pub async fn session_bounds_across_replicas(cluster: Arc<Cluster>) {
         .unwrap_or(0.0);
     assert_eq!(idle_a + idle_b, 2.0);
 }
+
+/// The database, not a replica's memory of its last answer, decides a
+/// retry: once another replica stepped or deleted the session, a key this
+/// replica answered is a new step (with any body) or a 404, as it is in
+/// memory. A step to an unknown id is a 404 whatever its body, a refused
+/// step of a live session does not leave it idle, and an id of another
+/// form is not found (never sent to the database).
+pub async fn retries_follow_the_database(cluster: Arc<Cluster>) {
+    let url = cluster.database("sessions_replays").await;
+    let args = ["--session-ttl-s", "3"];
+    let a = Server::start("a", &url, &args);
+    let b = Server::start("b", &url, &args);
+    let id = open(&a, &json!({"scenario_id": "paper-v10"})).await;
+    let path = format!("/v1/sessions/{id}/step");
+    let keyed = async |server: &Server, k: u32, key: &str| {
+        let (status, v) = body(server.post_with_key(&path, &step_body(k), key).await).await;
+        assert_eq!(status, StatusCode::OK, "step {k} with {key}: {v}");
+        v["step"].as_u64().unwrap()
+    };
+    assert_eq!(keyed(&a, 0, "k0").await, 0);
+    assert_eq!(step(&b, &id, 1).await["step"], 1);
+    // The last step had no key: k0 again is a new step, not a replay.
+    assert_eq!(keyed(&a, 0, "k0").await, 2);
+    assert_eq!(keyed(&b, 3, "k1").await, 3);
+    // k0 is no longer the last step's key: another body is a new step.
+    assert_eq!(keyed(&a, 4, "k0").await, 4);
+    // Refused steps through A keep the session used, as requests.
+    for _ in 0..3 {
+        tokio::time::sleep(Duration::from_millis(1200)).await;
+        let (status, problem) = body(a.post(&path, &json!({"sensors": 3})).await).await;
+        assert_eq!(status, StatusCode::BAD_REQUEST, "{problem}");
+    }
+    assert_eq!(
+        b.get(&format!("/v1/sessions/{id}")).await.status(),
+        StatusCode::OK
+    );
+    assert_eq!(
+        b.delete(&format!("/v1/sessions/{id}")).await.status(),
+        StatusCode::NO_CONTENT
+    );
+    let (status, problem) = body(a.post_with_key(&path, &step_body(4), "k0").await).await;
+    assert_eq!(status, StatusCode::NOT_FOUND, "{problem}");
+    // Unknown ids: 404 before the body is looked at; other forms too.
+    let unknown = format!("/v1/sessions/ss-{}/step", "0".repeat(32));
+    for server in [&a, &b] {
+        let (status, problem) = body(server.post(&unknown, &json!({"sensors": 3})).await).await;
+        assert_eq!(status, StatusCode::NOT_FOUND, "{problem}");
+        for odd in ["ss-%00", "ss-xyz", "x"] {
+            let (status, problem) = body(server.get(&format!("/v1/sessions/{odd}")).await).await;
+            assert_eq!(status, StatusCode::NOT_FOUND, "{odd}: {problem}");
+        }
+    }
+}

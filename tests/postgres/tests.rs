@@ -48,6 +48,9 @@ pub const ALL: &[(&str, Test)] = &[
     ("retried_steps_are_made_once", |c| {
         Box::pin(sessions::retried_steps_are_made_once(c))
     }),
+    ("retries_follow_the_database", |c| {
+        Box::pin(sessions::retries_follow_the_database(c))
+    }),
     ("session_bounds_across_replicas", |c| {
         Box::pin(sessions::session_bounds_across_replicas(c))
     }),
