@@ -31,7 +31,7 @@
 //! | crossings: rays × (nx + ny) | 6.406e-6 | the index of the rays' crossings of the grid |
 //!
 //! With obstacles the statistics cast rays instead of the closed forms,
-//! and [`precompute_ms`] adds them ([`obstacle_rays`], with two
+//! and [`precompute_ms`] adds them ([`obstacle_rays`], with three
 //! coefficients of their own). A plan with obstacles takes the windows
 //! for every look that sees its whole square, and the rays for what a
 //! ground look near an obstacle does not see (`sighted` below).
@@ -247,44 +247,60 @@ impl PlanTerms {
 /// of view) to compute.
 pub fn precompute_ms(s: &Scenario) -> f64 {
     let work = dot(&PRECOMPUTE_MODEL, &precompute_terms(s).to_array()).max(FLOOR_MS);
-    let obstacles = s.obstacles.list().len() as f64;
-    work + obstacle_rays(s) * (OBSTACLE_MS_PER_RAY + OBSTACLE_MS_PER_RAY_AND_OBSTACLE * obstacles)
+    let list = s.obstacles.list();
+    let vertices: usize = list.iter().map(|o| o.polygon.vertices().len()).sum();
+    work + obstacle_rays(s)
+        * (OBSTACLE_MS_PER_RAY
+            + OBSTACLE_MS_PER_RAY_AND_OBSTACLE * list.len() as f64
+            + OBSTACLE_MS_PER_RAY_AND_VERTEX * vertices as f64)
 }
 
 /// Milliseconds per ray of the statistics of a scenario with obstacles
-/// ([`obstacle_rays`]), and per ray and obstacle: a two-term model fitted
-/// on `site-campus` with its twelve obstacles and with four (its figures
-/// are in `docs/obstacles.md`). Those statistics integrate every cell's
-/// visible field of view along rays ([`crate::stats`]), where the closed
-/// forms the model's other terms count no longer apply.
-const OBSTACLE_MS_PER_RAY: f64 = 1.6e-5;
+/// ([`obstacle_rays`]), per ray and obstacle, and per ray and vertex:
+/// each ray is clipped by every building (where a target stops) and by the
+/// shadows that hide parts of the field of view, edge by edge. Fitted on
+/// `site-campus` (with its twelve obstacles, with four, with 5 m cells)
+/// and on yards of 4 to 64 obstacles of 4 to 32 vertices (the
+/// `cost_model` example's `obstacles` cases; figures in
+/// `docs/obstacles.md`). Those statistics integrate every cell's visible
+/// field of view along rays ([`crate::stats`]), where the closed forms
+/// the model's other terms count no longer apply.
+const OBSTACLE_MS_PER_RAY: f64 = 1.37e-5;
 /// See [`OBSTACLE_MS_PER_RAY`].
-const OBSTACLE_MS_PER_RAY_AND_OBSTACLE: f64 = 1.6e-6;
+const OBSTACLE_MS_PER_RAY_AND_OBSTACLE: f64 = 1.26e-6;
+/// See [`OBSTACLE_MS_PER_RAY`].
+const OBSTACLE_MS_PER_RAY_AND_VERTEX: f64 = 3.97e-7;
+
+/// Points per side of the grid over the zone on which [`obstacle_rays`]
+/// averages the angles a field of view spans.
+const RAY_SAMPLES_PER_SIDE: usize = 32;
 
 /// The rays the statistics of a scenario with obstacles cast: per view,
 /// cell and source, the angle the field of view spans seen from the
-/// source at the zone centre's distance, at [`OBSTACLE_STATS_RAYS_PER_PI`]
-/// rays per π. Zero without obstacles.
-fn obstacle_rays(s: &Scenario) -> f64 {
+/// source, at [`OBSTACLE_STATS_RAYS_PER_PI`] rays per π; the angle
+/// averaged over a grid of [`RAY_SAMPLES_PER_SIDE`]² points of the zone
+/// (a view near a source spans a wide angle). Zero without obstacles.
+pub fn obstacle_rays(s: &Scenario) -> f64 {
     if !s.has_obstacles() {
         return 0.0;
     }
-    let centre = Point::new(s.width / 2.0, s.height / 2.0);
-    let inverse_distances: f64 = s
-        .sources
-        .iter()
-        .filter(|src| src.rate > 0.0)
-        .map(|src| {
-            1.0 / (src.pos.x - centre.x)
-                .hypot(src.pos.y - centre.y)
-                .max(s.cell_size)
-        })
-        .sum();
-    let spans: f64 = s
-        .fovs
-        .iter()
-        .map(|&fov| 2.0 * half(fov) * inverse_distances / std::f64::consts::PI)
-        .sum();
+    let k = RAY_SAMPLES_PER_SIDE;
+    let mut spans = 0.0;
+    for &fov in &s.fovs {
+        let h = half(fov);
+        for src in s.sources.iter().filter(|src| src.rate > 0.0) {
+            let mut sum = 0.0;
+            for i in 0..k {
+                for j in 0..k {
+                    let x = s.width * (i as f64 + 0.5) / k as f64;
+                    let y = s.height * (j as f64 + 0.5) / k as f64;
+                    let r = (src.pos.x - x).hypot(src.pos.y - y);
+                    sum += 2.0 * (h / r.max(s.cell_size / 2.0)).atan();
+                }
+            }
+            spans += sum / (k * k) as f64 / std::f64::consts::PI;
+        }
+    }
     s.cell_count() as f64 * spans * OBSTACLE_STATS_RAYS_PER_PI as f64
 }
 

@@ -202,13 +202,32 @@ fn plan_cost_grows_with_each_driver() {
     increasing("coordination", MODES.map(|c| cost(10, 3, 50, 16, c)));
 }
 
-/// Obstacles add the statistics' rays: more with more obstacles and
-/// more cells, none without.
+/// Obstacles add the statistics' rays: more with more obstacles, more
+/// vertices and more cells, none without.
 #[test]
 fn precompute_cost_grows_with_obstacles() {
     let campus = crate::scenario::site_campus_spec();
     let cost =
         |spec: crate::scenario::ScenarioSpec| precompute_ms(&Scenario::new(spec).expect("valid"));
+    // The same obstacles drawn with more vertices each.
+    let rounded = |k: usize| {
+        let mut spec = campus.clone();
+        for ob in spec.obstacles.iter_mut().flatten() {
+            let n = ob.polygon.len() as f64;
+            let (cx, cy) = ob
+                .polygon
+                .iter()
+                .fold((0.0, 0.0), |(x, y), p| (x + p[0] / n, y + p[1] / n));
+            ob.polygon = (0..k)
+                .map(|j| {
+                    let a = std::f64::consts::TAU * j as f64 / k as f64;
+                    [cx + 4.0 * a.cos(), cy + 4.0 * a.sin()]
+                })
+                .collect();
+        }
+        cost(spec)
+    };
+    increasing("vertices", [rounded(4), rounded(16), rounded(32)]);
     let without = cost(crate::scenario::ScenarioSpec {
         obstacles: None,
         ..campus.clone()

@@ -20,6 +20,9 @@ pub enum Group {
     First,
     /// Precomputations.
     Precompute,
+    /// Precomputations with obstacles: predicted by `cost::precompute_ms`
+    /// whole (its obstacle terms are fitted apart, by hand, from these).
+    Obstacles,
 }
 
 impl Group {
@@ -29,6 +32,7 @@ impl Group {
             Group::Workload | Group::Extra | Group::Large => Model::Plan,
             Group::First => Model::First,
             Group::Precompute => Model::Precompute,
+            Group::Obstacles => Model::Whole,
         }
     }
 
@@ -39,17 +43,19 @@ impl Group {
             Group::Large => "plans, the issue's large cases",
             Group::First => "plans, first detections",
             Group::Precompute => "precompute",
+            Group::Obstacles => "precompute with obstacles",
         }
     }
 }
 
 /// The models of `vigil::cost`: `PLAN_MODEL`, `FIRST_MODEL` and
-/// `PRECOMPUTE_MODEL`.
+/// `PRECOMPUTE_MODEL`, or `cost::precompute_ms` whole (not refitted).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Model {
     Plan,
     First,
     Precompute,
+    Whole,
 }
 
 pub enum Work {
@@ -193,12 +199,16 @@ impl Builder {
     }
 
     fn pre(&mut self, name: String, s: Scenario, run: bool) {
+        self.pre_in(Group::Precompute, name, s, run);
+    }
+
+    fn pre_in(&mut self, group: Group, name: String, s: Scenario, run: bool) {
         let name = format!("precompute {name}");
         if self.wanted(&name) {
             let s = Box::new(s);
             self.cases.push(Case {
                 name,
-                group: Group::Precompute,
+                group,
                 work: if run {
                     Work::Precompute(s)
                 } else {
@@ -543,6 +553,91 @@ pub fn precompute_cases(b: &mut Builder, large: bool) {
     b.pre(
         "site-gates, circle r30".into(),
         Scenario::new(gates_circle).unwrap(),
+        true,
+    );
+}
+
+/// A 400 × 300 yard of 10 m cells, with ground robots and drones, two
+/// sources and `n` obstacles (`n ≤ 64`), each a regular polygon of `k`
+/// vertices and radius 6 on a grid, every other one a screen; fields of
+/// view `fov` (the robots') and twice its size (the drones').
+fn yard(n: usize, k: usize, fov: FovSpec) -> Scenario {
+    let obstacles = (0..n)
+        .map(|i| {
+            let (cx, cy) = (25.0 + (i % 8) as f64 * 50.0, 20.0 + (i / 8) as f64 * 37.5);
+            serde_json::json!({
+                "polygon": (0..k).map(|j| {
+                    let a = std::f64::consts::TAU * (j as f64 + 0.3) / k as f64;
+                    [cx + 6.0 * a.cos(), cy + 6.0 * a.sin()]
+                }).collect::<Vec<_>>(),
+                "kind": if i % 2 == 0 { "building" } else { "screen" },
+            })
+        })
+        .collect::<Vec<_>>();
+    let wide = match fov {
+        FovSpec::Square { half_width } => square(2.0 * half_width),
+        FovSpec::Circle { radius } => circle(2.0 * radius),
+    };
+    let spec = serde_json::json!({
+        "name": format!("yard, {n} obstacles of {k} vertices, {fov:?}"),
+        "zone": {"width": 400, "height": 300}, "cell_size": 10, "target_speed": 5,
+        "fov": fov,
+        "sensor_types": {"drone": {"fov": wide, "speed": 3, "elevated": true}},
+        "obstacles": obstacles,
+        "sources": [{"x": -1, "y": 150, "rate": 0.5}, {"x": 401, "y": 100, "rate": 0.5}],
+    });
+    Scenario::new(serde_json::from_value(spec).unwrap()).unwrap()
+}
+
+/// Precomputations with obstacles, whose statistics cast rays: more
+/// obstacles, more vertices, circles and smaller cells.
+pub fn obstacle_cases(b: &mut Builder) {
+    for (n, k) in [
+        (4, 4),
+        (16, 4),
+        (64, 4),
+        (16, 16),
+        (64, 16),
+        (16, 32),
+        (64, 32),
+    ] {
+        b.pre_in(
+            Group::Obstacles,
+            format!("obstacles: yard {n}×{k}"),
+            yard(n, k, square(20.0)),
+            true,
+        );
+    }
+    for (n, k) in [(16, 8), (64, 32)] {
+        b.pre_in(
+            Group::Obstacles,
+            format!("obstacles: yard {n}×{k}, circle r20"),
+            yard(n, k, circle(20.0)),
+            true,
+        );
+    }
+    let mut campus = vigil::scenario::site_campus_spec();
+    b.pre_in(
+        Group::Obstacles,
+        "obstacles: site-campus".into(),
+        Scenario::new(campus.clone()).unwrap(),
+        true,
+    );
+    campus.cell_size = 5.0;
+    b.pre_in(
+        Group::Obstacles,
+        "obstacles: site-campus, 5 m cells".into(),
+        Scenario::new(campus.clone()).unwrap(),
+        true,
+    );
+    campus.cell_size = 10.0;
+    if let Some(list) = campus.obstacles.as_mut() {
+        list.truncate(4);
+    }
+    b.pre_in(
+        Group::Obstacles,
+        "obstacles: site-campus, 4 obstacles".into(),
+        Scenario::new(campus).unwrap(),
         true,
     );
 }

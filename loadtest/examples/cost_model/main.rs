@@ -10,7 +10,9 @@
 //! plans, plans that maximise first detections (horizons, coordinations,
 //! sensors, the built-ins' fleets; `cases::first_cases`), and
 //! precomputations (lattice size, fields of view, sources, sensor types,
-//! cones).
+//! cones), and precomputations with obstacles (`--only obstacles`; these
+//! are predicted by `cost::precompute_ms` whole, whose obstacle terms are
+//! fitted apart).
 //!
 //! Each case runs inside a one-thread rayon pool; its time is the CPU time
 //! of that thread (`/proc/thread-self/schedstat`, after a `sched_yield` so
@@ -127,6 +129,7 @@ fn main() {
     cases::plan_cases(&mut b);
     cases::first_cases(&mut b);
     cases::precompute_cases(&mut b, large);
+    cases::obstacle_cases(&mut b);
     eprintln!(
         "{} cases built in {:.0} s",
         b.cases.len(),
@@ -169,6 +172,9 @@ fn main() {
                 } else {
                     terms.to_vec()
                 }
+            }
+            Work::Precompute(s) | Work::PredictOnly(s) if case.group.model() == Model::Whole => {
+                vec![cost::precompute_ms(s)]
             }
             Work::Precompute(s) | Work::PredictOnly(s) => {
                 cost::precompute_terms(s).to_array().to_vec()
@@ -235,11 +241,13 @@ fn main() {
             Model::Plan => ("PLAN_MODEL", split(&cost::PLAN_MODEL)),
             Model::First => ("FIRST_MODEL", split(&cost::FIRST_MODEL)),
             Model::Precompute => ("PRECOMPUTE_MODEL", split(&cost::PRECOMPUTE_MODEL)),
+            Model::Whole => ("precompute_ms", (vec!["predicted ms"], vec![1.0])),
         };
         (what, names, coef)
     };
     let mut refits = BTreeMap::new();
     for m in [Model::Precompute, Model::Plan, Model::First] {
+        // (`Model::Whole` is the prediction itself: nothing to refit.)
         let rows: Vec<(Vec<f64>, f64)> = results
             .iter()
             .filter(|(ci, _, ms)| b.cases[*ci].group.model() == m && ms.is_finite())
