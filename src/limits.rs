@@ -58,6 +58,10 @@ pub const MAX_OBSTACLES: usize = 64;
 pub const MIN_OBSTACLE_VERTICES: usize = 3;
 /// Most vertices of an obstacle's polygon.
 pub const MAX_OBSTACLE_VERTICES: usize = 32;
+/// Largest magnitude of an obstacle vertex's coordinates: a polygon may
+/// reach far past the zone, but not so far that the rounding of its
+/// edges' lines (about 1e-16 of it) matters at the zone's scale.
+pub const MAX_OBSTACLE_COORDINATE: f64 = 1e9;
 /// Rays per π over which the statistics of a scenario with obstacles
 /// integrate each cell's visible field of view (its closed forms no longer
 /// apply), and its check that every source's cone reaches the zone.

@@ -183,7 +183,12 @@ impl Polygon {
             vertices,
             edges,
             bbox,
-            eps: 1e-9 * scale,
+            // A cell centre on an edge is inside despite rounding: 1e-9 of
+            // the coordinates' size, but at most 1e-5, so that a polygon
+            // with far vertices does not take in the cells near it; the
+            // rounding of an edge's line (about 1e-16 of its vertices'
+            // size) is covered by the second term.
+            eps: 1e-9 * scale.min(1e4) + 1e-13 * scale,
         })
     }
 

@@ -5,7 +5,9 @@ use utoipa::ToSchema;
 
 use super::ValidationError;
 use crate::geometry::{Point, Rect};
-use crate::limits::{MAX_OBSTACLE_VERTICES, MAX_OBSTACLES, MIN_OBSTACLE_VERTICES};
+use crate::limits::{
+    MAX_OBSTACLE_COORDINATE, MAX_OBSTACLE_VERTICES, MAX_OBSTACLES, MIN_OBSTACLE_VERTICES,
+};
 use crate::obstacle::{Obstacle, ObstacleKind, Obstacles, Polygon};
 
 /// An obstacle as clients send it: a convex polygon and what it blocks.
@@ -17,8 +19,8 @@ use crate::obstacle::{Obstacle, ObstacleKind, Obstacles, Polygon};
 pub struct ObstacleSpec {
     /// The outline: 3 to 32 vertices `[x, y]` of a convex polygon, in zone
     /// coordinates, in either order around it, no vertex repeated and no
-    /// three consecutive ones collinear. It may cross the zone's edge but
-    /// not lie wholly outside it.
+    /// three consecutive ones collinear, each coordinate within ±1e9. It
+    /// may cross the zone's edge but not lie wholly outside it.
     #[schema(value_type = Vec<Vec<f64>>)]
     #[serde(deserialize_with = "vertices")]
     pub polygon: Vec<[f64; 2]>,
@@ -112,6 +114,18 @@ pub(super) fn validate(
             return Err(ValidationError::new(
                 field,
                 format!("{MIN_OBSTACLE_VERTICES} to {MAX_OBSTACLE_VERTICES} vertices, got {n}"),
+            ));
+        }
+        // (Not finite: Polygon::new names it.)
+        if let Some(j) = spec.polygon.iter().position(|v| {
+            v.iter()
+                .any(|c| c.is_finite() && c.abs() > MAX_OBSTACLE_COORDINATE)
+        }) {
+            return Err(ValidationError::new(
+                field,
+                format!(
+                    "vertex {j} has a coordinate beyond ±{MAX_OBSTACLE_COORDINATE:e}, the most any may have"
+                ),
             ));
         }
         let points: Vec<Point> = spec

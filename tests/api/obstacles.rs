@@ -288,6 +288,18 @@ async fn malformed_obstacles_are_refused_naming_the_field() {
             with(json!([{"polygon": [[110.0, 10.0], [130.0, 10.0], [120.0, 30.0]]}])),
             "obstacles[0].polygon",
         ),
+        // Coordinates past the limit (where a cross product of 1e200
+        // overflows).
+        (
+            with(json!([{"polygon": [[40.0, 40.0], [60.0, 40.0], [60.0, 2e9]]}])),
+            "obstacles[0].polygon",
+        ),
+        (
+            with(
+                json!([{"polygon": [[-1e200, -1e200], [1e200, -1e200], [1e200, 1e200], [-1e200, 1e200]]}]),
+            ),
+            "obstacles[0].polygon",
+        ),
         // An unknown kind.
         (
             with(json!([{"polygon": square}, {"polygon": square, "kind": "wall"}])),
@@ -318,6 +330,25 @@ async fn malformed_obstacles_are_refused_naming_the_field() {
     let across =
         with(json!([{"polygon": [[90.0, 10.0], [120.0, 10.0], [120.0, 30.0], [90.0, 30.0]]}]));
     register(&app, &across).await;
+    // So is one that reaches as far as the limit; it takes in no cell
+    // centre beyond its edges (the one at x = 55 is half a unit out).
+    let far = with(json!([{"polygon": [[44.0, -1e9], [54.5, -1e9], [54.5, 25.0], [44.0, 25.0]]}]));
+    let id = register(&app, &far).await;
+    for (x, status) in [
+        (55.0, StatusCode::OK),
+        (45.0, StatusCode::UNPROCESSABLE_ENTITY),
+    ] {
+        let body = json!({"sensors": [{"id": 1, "x": x, "y": 15.0}], "horizon": 1});
+        let res = app
+            .post_json(&format!("/v1/scenarios/{id}/plan"), &body)
+            .await;
+        assert_eq!(
+            res.status(),
+            status,
+            "x = {x}: {}",
+            res.text().await.unwrap()
+        );
+    }
     // Non-numeric vertices, and vertices of other than two numbers, are a
     // 400 that names the vertex (not JSON that fails to parse).
     for (vertex, says) in [

@@ -21,8 +21,8 @@ class ObstacleSpec:
     Attributes:
         polygon (list[list[float]]): The outline: 3 to 32 vertices `[x, y]` of a convex polygon, in zone
             coordinates, in either order around it, no vertex repeated and no
-            three consecutive ones collinear. It may cross the zone's edge but
-            not lie wholly outside it.
+            three consecutive ones collinear, each coordinate within ±1e9. It
+            may cross the zone's edge but not lie wholly outside it.
         kind (None | ObstacleKindName | Unset):
     """
 
