@@ -7,6 +7,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use axum::Extension;
+use serde::Deserialize as _;
 
 use super::config::INLINE_PLAN_MS;
 use super::error::ApiError;
@@ -198,8 +199,18 @@ pub(super) async fn resolve_scenario(
             ));
         }
         (None, Some(spec)) => {
-            let spec: ScenarioSpec = serde_json::from_value(spec)
-                .map_err(|e| ApiError::MalformedBody(format!("scenario: {e}")))?;
+            let spec = ScenarioSpec::deserialize(&spec).map_err(|_| {
+                // Again, only to name the field (as `POST /v1/scenarios`
+                // does): the path's bookkeeping slows every parse.
+                let detail = match serde_path_to_error::deserialize::<_, ScenarioSpec>(&spec) {
+                    Err(e) if e.path().iter().next().is_some() => {
+                        format!("scenario.{}: {}", e.path(), e.inner())
+                    }
+                    Err(e) => format!("scenario: {}", e.inner()),
+                    Ok(_) => "scenario: not a valid scenario spec".to_owned(),
+                };
+                ApiError::MalformedBody(detail)
+            })?;
             let scenario = Scenario::new(spec).map_err(|mut e| {
                 e.field = format!("scenario.{}", e.field);
                 e

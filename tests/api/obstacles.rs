@@ -371,6 +371,36 @@ async fn malformed_obstacles_are_refused_naming_the_field() {
             "{detail}"
         );
     }
+    // Inline, the same defects name the field under `scenario.`.
+    for (obstacle, field) in [
+        (
+            json!({"polygon": square, "kind": 3}),
+            "scenario.obstacles[1].kind: invalid type",
+        ),
+        (
+            json!({"polygon": square, "height": 3}),
+            "scenario.obstacles[1].height: unknown field",
+        ),
+        (
+            json!({"polygon": [[1.0, 2.0, 3.0]]}),
+            "scenario.obstacles[1].polygon[0]: invalid length",
+        ),
+    ] {
+        let scenario = with(json!([{"polygon": square}, obstacle]));
+        let body = json!({"scenario": scenario, "sensors": [{"id": 1, "x": 15.0, "y": 15.0}]});
+        for path in ["/v1/plan", "/v1/evaluate"] {
+            let mut body = body.clone();
+            if path == "/v1/evaluate" {
+                body["paths"] = json!([]);
+            }
+            assert_problem(
+                app.post_json(path, &body).await,
+                StatusCode::BAD_REQUEST,
+                field,
+            )
+            .await;
+        }
+    }
 }
 
 /// The built-in campus plans for a fleet of robots and drones.
