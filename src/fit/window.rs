@@ -185,6 +185,18 @@ impl TrackBook {
                     ),
                 ));
             }
+            if !looks
+                .iter()
+                .any(|l| near(&l.region, q, tol.look) && in_sight(s, l, q, tol.look))
+            {
+                return Err(ValidationError::new(
+                    name(),
+                    format!(
+                        "({}, {}) lies behind an obstacle from every look of this step whose field of view holds it: none of its looks can have detected it",
+                        d.x, d.y
+                    ),
+                ));
+            }
             match self.last.get(&key) {
                 Some(&(then, p)) => {
                     let steps = step.saturating_sub(then).max(1) as f64;
@@ -243,6 +255,20 @@ pub struct Observed {
 }
 
 /// True when `q` lies within `tol` of the region.
+/// True when `look` sees `q` (an elevated look, or a clear sight line
+/// from a ground look's viewpoint), or a point within `tol` of it in one
+/// of the axes' directions: a detection reported on a shadow's edge is
+/// not refused for rounding.
+fn in_sight(s: &Scenario, look: &Look, q: Point, tol: f64) -> bool {
+    let Some(from) = look.from else {
+        return true;
+    };
+    let near_by = [(0.0, 0.0), (tol, 0.0), (-tol, 0.0), (0.0, tol), (0.0, -tol)];
+    near_by
+        .iter()
+        .any(|&(dx, dy)| s.obstacles.clear(from, Point::new(q.x + dx, q.y + dy)))
+}
+
 fn near(region: &Region, q: Point, tol: f64) -> bool {
     let r = &region.rect;
     let dx = (r.x0 - q.x).max(0.0).max(q.x - r.x1);

@@ -431,3 +431,40 @@ async fn site_campus_plans_a_mixed_fleet() {
     )
     .await;
 }
+
+/// `fit` takes a detection only from a look that could have made it: a
+/// ground camera's view behind a building detects nothing there, a
+/// drone's over it does.
+#[tokio::test]
+async fn fit_refuses_a_detection_behind_a_building() {
+    let app = spawn_app().await;
+    let spec = json!({
+        "zone": {"width": 200, "height": 100}, "cell_size": 10,
+        "fov": {"shape": "square", "half_width": 25}, "p_detect": 0.9, "target_speed": 5,
+        "sensor_types": {"drone": {"fov": {"shape": "square", "half_width": 25}, "elevated": true}},
+        "obstacles": [{"polygon": [[80, 30], [120, 30], [120, 70], [80, 70]]}],
+        "sources": [{"x": -1, "y": 50, "rate": 0.4}, {"x": 201, "y": 50, "rate": 0.4}]});
+    let id = register(&app, &spec).await;
+    let url = format!("/v1/scenarios/{id}/fit");
+    let window = |sensor: Value, x: f64| {
+        json!({"steps": [{"sensors": [sensor],
+            "detections": [{"id": 1, "x": x, "y": 25.0, "vx": 4.8, "vy": -1.3}]}]})
+    };
+    let camera = json!({"id": "a", "x": 75.0, "y": 45.0});
+    let drone = json!({"id": "a", "x": 75.0, "y": 45.0, "type": "drone"});
+    // The sight line from (75, 45) to (95, 25) crosses the building.
+    assert_validation(
+        app.post_json(&url, &window(camera.clone(), 95.0)).await,
+        "steps[0].detections[0]",
+    )
+    .await;
+    for (sensor, x) in [(camera, 60.0), (drone, 95.0)] {
+        let res = app.post_json(&url, &window(sensor, x)).await;
+        assert_eq!(
+            res.status(),
+            StatusCode::OK,
+            "{}",
+            res.text().await.unwrap()
+        );
+    }
+}
