@@ -34,8 +34,11 @@ macro_rules! spec_rules {
         `direction` is beside exactly one edge of the zone or gives a `heading` whose \
         half-plane holds the zone; some direction of each source's cone enters the zone; \
         `target_speed` is required when some source gives no `speeds`; a source's weights sum \
-        to a finite number; and Σ rate·diagonal/speed over the speed classes is at most 1e9 \
-        (the statistics stay finite)."
+        to a finite number; Σ rate·diagonal/speed over the speed classes is at most 1e9 \
+        (the statistics stay finite); each obstacle's polygon is convex, with no repeated \
+        vertex and no three consecutive ones collinear, and not wholly outside the zone; no \
+        source lies inside a building, and some direction of each source's cone enters the \
+        zone before any building."
     };
 }
 
@@ -43,7 +46,9 @@ macro_rules! spec_rules {
 macro_rules! plan_rules {
     () => {
         " Rules no schema can state (each a 422 whose `detail` names the field): every sensor \
-        and history position lies in the scenario's zone, and sensor ids are unique."
+        and history position lies in the scenario's zone, and sensor ids are unique; no ground \
+        sensor (a type not `elevated`), now or in the history, stands on a cell whose centre \
+        lies in a building; and with obstacles the estimator is `exact`."
     };
 }
 
@@ -52,8 +57,9 @@ macro_rules! path_rules {
     () => {
         " The paths' rules (each a 422 whose `detail` names the field): one path per sensor, \
         each naming a sensor of `sensors` once, of exactly T cells (the horizon's steps 1..T), \
-        every cell on the lattice and outside the no-go zones, each step a move of at most the \
-        sensor type's speed (king moves) that free cells allow, from the sensor's own cell."
+        every cell on the lattice and outside the no-go zones (and, for a ground sensor, \
+        outside the buildings), each step a move of at most the sensor type's speed (king \
+        moves) that free cells allow, from the sensor's own cell."
     };
 }
 

@@ -105,16 +105,21 @@ def sync_detailed(
      The same scoring as `POST /v1/scenarios/{id}/evaluate`, with the scenario in the body as in `POST
     /v1/plan`: exactly one of `scenario_id` and `scenario`. Rules no schema can state (each a 422 whose
     `detail` names the field): every sensor and history position lies in the scenario's zone, and sensor
-    ids are unique. The paths' rules (each a 422 whose `detail` names the field): one path per sensor,
-    each naming a sensor of `sensors` once, of exactly T cells (the horizon's steps 1..T), every cell on
-    the lattice and outside the no-go zones, each step a move of at most the sensor type's speed (king
-    moves) that free cells allow, from the sensor's own cell. Rules no schema can state (each a 422
-    whose `detail` names the field): the zone's width and height are whole multiples of `cell_size`, and
-    the lattice has at most 4,000,000 cells; every source lies strictly outside the zone; a source
-    without `direction` is beside exactly one edge of the zone or gives a `heading` whose half-plane
-    holds the zone; some direction of each source's cone enters the zone; `target_speed` is required
-    when some source gives no `speeds`; a source's weights sum to a finite number; and Σ
-    rate·diagonal/speed over the speed classes is at most 1e9 (the statistics stay finite).
+    ids are unique; no ground sensor (a type not `elevated`), now or in the history, stands on a cell
+    whose centre lies in a building; and with obstacles the estimator is `exact`. The paths' rules (each
+    a 422 whose `detail` names the field): one path per sensor, each naming a sensor of `sensors` once,
+    of exactly T cells (the horizon's steps 1..T), every cell on the lattice and outside the no-go zones
+    (and, for a ground sensor, outside the buildings), each step a move of at most the sensor type's
+    speed (king moves) that free cells allow, from the sensor's own cell. Rules no schema can state
+    (each a 422 whose `detail` names the field): the zone's width and height are whole multiples of
+    `cell_size`, and the lattice has at most 4,000,000 cells; every source lies strictly outside the
+    zone; a source without `direction` is beside exactly one edge of the zone or gives a `heading` whose
+    half-plane holds the zone; some direction of each source's cone enters the zone; `target_speed` is
+    required when some source gives no `speeds`; a source's weights sum to a finite number; Σ
+    rate·diagonal/speed over the speed classes is at most 1e9 (the statistics stay finite); each
+    obstacle's polygon is convex, with no repeated vertex and no three consecutive ones collinear, and
+    not wholly outside the zone; no source lies inside a building, and some direction of each source's
+    cone enters the zone before any building.
 
     Args:
         body (EvaluateRequestById | EvaluateRequestWithScenario): Body of `POST /v1/evaluate`: the
@@ -151,16 +156,21 @@ def sync(
      The same scoring as `POST /v1/scenarios/{id}/evaluate`, with the scenario in the body as in `POST
     /v1/plan`: exactly one of `scenario_id` and `scenario`. Rules no schema can state (each a 422 whose
     `detail` names the field): every sensor and history position lies in the scenario's zone, and sensor
-    ids are unique. The paths' rules (each a 422 whose `detail` names the field): one path per sensor,
-    each naming a sensor of `sensors` once, of exactly T cells (the horizon's steps 1..T), every cell on
-    the lattice and outside the no-go zones, each step a move of at most the sensor type's speed (king
-    moves) that free cells allow, from the sensor's own cell. Rules no schema can state (each a 422
-    whose `detail` names the field): the zone's width and height are whole multiples of `cell_size`, and
-    the lattice has at most 4,000,000 cells; every source lies strictly outside the zone; a source
-    without `direction` is beside exactly one edge of the zone or gives a `heading` whose half-plane
-    holds the zone; some direction of each source's cone enters the zone; `target_speed` is required
-    when some source gives no `speeds`; a source's weights sum to a finite number; and Σ
-    rate·diagonal/speed over the speed classes is at most 1e9 (the statistics stay finite).
+    ids are unique; no ground sensor (a type not `elevated`), now or in the history, stands on a cell
+    whose centre lies in a building; and with obstacles the estimator is `exact`. The paths' rules (each
+    a 422 whose `detail` names the field): one path per sensor, each naming a sensor of `sensors` once,
+    of exactly T cells (the horizon's steps 1..T), every cell on the lattice and outside the no-go zones
+    (and, for a ground sensor, outside the buildings), each step a move of at most the sensor type's
+    speed (king moves) that free cells allow, from the sensor's own cell. Rules no schema can state
+    (each a 422 whose `detail` names the field): the zone's width and height are whole multiples of
+    `cell_size`, and the lattice has at most 4,000,000 cells; every source lies strictly outside the
+    zone; a source without `direction` is beside exactly one edge of the zone or gives a `heading` whose
+    half-plane holds the zone; some direction of each source's cone enters the zone; `target_speed` is
+    required when some source gives no `speeds`; a source's weights sum to a finite number; Σ
+    rate·diagonal/speed over the speed classes is at most 1e9 (the statistics stay finite); each
+    obstacle's polygon is convex, with no repeated vertex and no three consecutive ones collinear, and
+    not wholly outside the zone; no source lies inside a building, and some direction of each source's
+    cone enters the zone before any building.
 
     Args:
         body (EvaluateRequestById | EvaluateRequestWithScenario): Body of `POST /v1/evaluate`: the
@@ -192,16 +202,21 @@ async def asyncio_detailed(
      The same scoring as `POST /v1/scenarios/{id}/evaluate`, with the scenario in the body as in `POST
     /v1/plan`: exactly one of `scenario_id` and `scenario`. Rules no schema can state (each a 422 whose
     `detail` names the field): every sensor and history position lies in the scenario's zone, and sensor
-    ids are unique. The paths' rules (each a 422 whose `detail` names the field): one path per sensor,
-    each naming a sensor of `sensors` once, of exactly T cells (the horizon's steps 1..T), every cell on
-    the lattice and outside the no-go zones, each step a move of at most the sensor type's speed (king
-    moves) that free cells allow, from the sensor's own cell. Rules no schema can state (each a 422
-    whose `detail` names the field): the zone's width and height are whole multiples of `cell_size`, and
-    the lattice has at most 4,000,000 cells; every source lies strictly outside the zone; a source
-    without `direction` is beside exactly one edge of the zone or gives a `heading` whose half-plane
-    holds the zone; some direction of each source's cone enters the zone; `target_speed` is required
-    when some source gives no `speeds`; a source's weights sum to a finite number; and Σ
-    rate·diagonal/speed over the speed classes is at most 1e9 (the statistics stay finite).
+    ids are unique; no ground sensor (a type not `elevated`), now or in the history, stands on a cell
+    whose centre lies in a building; and with obstacles the estimator is `exact`. The paths' rules (each
+    a 422 whose `detail` names the field): one path per sensor, each naming a sensor of `sensors` once,
+    of exactly T cells (the horizon's steps 1..T), every cell on the lattice and outside the no-go zones
+    (and, for a ground sensor, outside the buildings), each step a move of at most the sensor type's
+    speed (king moves) that free cells allow, from the sensor's own cell. Rules no schema can state
+    (each a 422 whose `detail` names the field): the zone's width and height are whole multiples of
+    `cell_size`, and the lattice has at most 4,000,000 cells; every source lies strictly outside the
+    zone; a source without `direction` is beside exactly one edge of the zone or gives a `heading` whose
+    half-plane holds the zone; some direction of each source's cone enters the zone; `target_speed` is
+    required when some source gives no `speeds`; a source's weights sum to a finite number; Σ
+    rate·diagonal/speed over the speed classes is at most 1e9 (the statistics stay finite); each
+    obstacle's polygon is convex, with no repeated vertex and no three consecutive ones collinear, and
+    not wholly outside the zone; no source lies inside a building, and some direction of each source's
+    cone enters the zone before any building.
 
     Args:
         body (EvaluateRequestById | EvaluateRequestWithScenario): Body of `POST /v1/evaluate`: the
@@ -236,16 +251,21 @@ async def asyncio(
      The same scoring as `POST /v1/scenarios/{id}/evaluate`, with the scenario in the body as in `POST
     /v1/plan`: exactly one of `scenario_id` and `scenario`. Rules no schema can state (each a 422 whose
     `detail` names the field): every sensor and history position lies in the scenario's zone, and sensor
-    ids are unique. The paths' rules (each a 422 whose `detail` names the field): one path per sensor,
-    each naming a sensor of `sensors` once, of exactly T cells (the horizon's steps 1..T), every cell on
-    the lattice and outside the no-go zones, each step a move of at most the sensor type's speed (king
-    moves) that free cells allow, from the sensor's own cell. Rules no schema can state (each a 422
-    whose `detail` names the field): the zone's width and height are whole multiples of `cell_size`, and
-    the lattice has at most 4,000,000 cells; every source lies strictly outside the zone; a source
-    without `direction` is beside exactly one edge of the zone or gives a `heading` whose half-plane
-    holds the zone; some direction of each source's cone enters the zone; `target_speed` is required
-    when some source gives no `speeds`; a source's weights sum to a finite number; and Σ
-    rate·diagonal/speed over the speed classes is at most 1e9 (the statistics stay finite).
+    ids are unique; no ground sensor (a type not `elevated`), now or in the history, stands on a cell
+    whose centre lies in a building; and with obstacles the estimator is `exact`. The paths' rules (each
+    a 422 whose `detail` names the field): one path per sensor, each naming a sensor of `sensors` once,
+    of exactly T cells (the horizon's steps 1..T), every cell on the lattice and outside the no-go zones
+    (and, for a ground sensor, outside the buildings), each step a move of at most the sensor type's
+    speed (king moves) that free cells allow, from the sensor's own cell. Rules no schema can state
+    (each a 422 whose `detail` names the field): the zone's width and height are whole multiples of
+    `cell_size`, and the lattice has at most 4,000,000 cells; every source lies strictly outside the
+    zone; a source without `direction` is beside exactly one edge of the zone or gives a `heading` whose
+    half-plane holds the zone; some direction of each source's cone enters the zone; `target_speed` is
+    required when some source gives no `speeds`; a source's weights sum to a finite number; Σ
+    rate·diagonal/speed over the speed classes is at most 1e9 (the statistics stay finite); each
+    obstacle's polygon is convex, with no repeated vertex and no three consecutive ones collinear, and
+    not wholly outside the zone; no source lies inside a building, and some direction of each source's
+    cone enters the zone before any building.
 
     Args:
         body (EvaluateRequestById | EvaluateRequestWithScenario): Body of `POST /v1/evaluate`: the

@@ -110,11 +110,13 @@ def sync_detailed(
     `budget_ms` play no part) plus `paths`. A plan's own paths score its `expected_detections`. With the
     `paper` estimator, whose total depends on the order, the paths count in the order given, the first
     as the highest priority. Rules no schema can state (each a 422 whose `detail` names the field):
-    every sensor and history position lies in the scenario's zone, and sensor ids are unique. The paths'
-    rules (each a 422 whose `detail` names the field): one path per sensor, each naming a sensor of
-    `sensors` once, of exactly T cells (the horizon's steps 1..T), every cell on the lattice and outside
-    the no-go zones, each step a move of at most the sensor type's speed (king moves) that free cells
-    allow, from the sensor's own cell.
+    every sensor and history position lies in the scenario's zone, and sensor ids are unique; no ground
+    sensor (a type not `elevated`), now or in the history, stands on a cell whose centre lies in a
+    building; and with obstacles the estimator is `exact`. The paths' rules (each a 422 whose `detail`
+    names the field): one path per sensor, each naming a sensor of `sensors` once, of exactly T cells
+    (the horizon's steps 1..T), every cell on the lattice and outside the no-go zones (and, for a ground
+    sensor, outside the buildings), each step a move of at most the sensor type's speed (king moves)
+    that free cells allow, from the sensor's own cell.
 
     Args:
         id (str):
@@ -157,11 +159,13 @@ def sync(
     `budget_ms` play no part) plus `paths`. A plan's own paths score its `expected_detections`. With the
     `paper` estimator, whose total depends on the order, the paths count in the order given, the first
     as the highest priority. Rules no schema can state (each a 422 whose `detail` names the field):
-    every sensor and history position lies in the scenario's zone, and sensor ids are unique. The paths'
-    rules (each a 422 whose `detail` names the field): one path per sensor, each naming a sensor of
-    `sensors` once, of exactly T cells (the horizon's steps 1..T), every cell on the lattice and outside
-    the no-go zones, each step a move of at most the sensor type's speed (king moves) that free cells
-    allow, from the sensor's own cell.
+    every sensor and history position lies in the scenario's zone, and sensor ids are unique; no ground
+    sensor (a type not `elevated`), now or in the history, stands on a cell whose centre lies in a
+    building; and with obstacles the estimator is `exact`. The paths' rules (each a 422 whose `detail`
+    names the field): one path per sensor, each naming a sensor of `sensors` once, of exactly T cells
+    (the horizon's steps 1..T), every cell on the lattice and outside the no-go zones (and, for a ground
+    sensor, outside the buildings), each step a move of at most the sensor type's speed (king moves)
+    that free cells allow, from the sensor's own cell.
 
     Args:
         id (str):
@@ -199,11 +203,13 @@ async def asyncio_detailed(
     `budget_ms` play no part) plus `paths`. A plan's own paths score its `expected_detections`. With the
     `paper` estimator, whose total depends on the order, the paths count in the order given, the first
     as the highest priority. Rules no schema can state (each a 422 whose `detail` names the field):
-    every sensor and history position lies in the scenario's zone, and sensor ids are unique. The paths'
-    rules (each a 422 whose `detail` names the field): one path per sensor, each naming a sensor of
-    `sensors` once, of exactly T cells (the horizon's steps 1..T), every cell on the lattice and outside
-    the no-go zones, each step a move of at most the sensor type's speed (king moves) that free cells
-    allow, from the sensor's own cell.
+    every sensor and history position lies in the scenario's zone, and sensor ids are unique; no ground
+    sensor (a type not `elevated`), now or in the history, stands on a cell whose centre lies in a
+    building; and with obstacles the estimator is `exact`. The paths' rules (each a 422 whose `detail`
+    names the field): one path per sensor, each naming a sensor of `sensors` once, of exactly T cells
+    (the horizon's steps 1..T), every cell on the lattice and outside the no-go zones (and, for a ground
+    sensor, outside the buildings), each step a move of at most the sensor type's speed (king moves)
+    that free cells allow, from the sensor's own cell.
 
     Args:
         id (str):
@@ -244,11 +250,13 @@ async def asyncio(
     `budget_ms` play no part) plus `paths`. A plan's own paths score its `expected_detections`. With the
     `paper` estimator, whose total depends on the order, the paths count in the order given, the first
     as the highest priority. Rules no schema can state (each a 422 whose `detail` names the field):
-    every sensor and history position lies in the scenario's zone, and sensor ids are unique. The paths'
-    rules (each a 422 whose `detail` names the field): one path per sensor, each naming a sensor of
-    `sensors` once, of exactly T cells (the horizon's steps 1..T), every cell on the lattice and outside
-    the no-go zones, each step a move of at most the sensor type's speed (king moves) that free cells
-    allow, from the sensor's own cell.
+    every sensor and history position lies in the scenario's zone, and sensor ids are unique; no ground
+    sensor (a type not `elevated`), now or in the history, stands on a cell whose centre lies in a
+    building; and with obstacles the estimator is `exact`. The paths' rules (each a 422 whose `detail`
+    names the field): one path per sensor, each naming a sensor of `sensors` once, of exactly T cells
+    (the horizon's steps 1..T), every cell on the lattice and outside the no-go zones (and, for a ground
+    sensor, outside the buildings), each step a move of at most the sensor type's speed (king moves)
+    that free cells allow, from the sensor's own cell.
 
     Args:
         id (str):

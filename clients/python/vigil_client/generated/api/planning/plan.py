@@ -108,13 +108,17 @@ def sync_detailed(
     required. An inline scenario whose precomputation is predicted above the server's synchronous budget
     is refused with 422: register it instead. A plan predicted above `--max-plan-ms` is refused with 422
     too. Rules no schema can state (each a 422 whose `detail` names the field): every sensor and history
-    position lies in the scenario's zone, and sensor ids are unique. Rules no schema can state (each a
-    422 whose `detail` names the field): the zone's width and height are whole multiples of `cell_size`,
-    and the lattice has at most 4,000,000 cells; every source lies strictly outside the zone; a source
-    without `direction` is beside exactly one edge of the zone or gives a `heading` whose half-plane
-    holds the zone; some direction of each source's cone enters the zone; `target_speed` is required
-    when some source gives no `speeds`; a source's weights sum to a finite number; and Σ
-    rate·diagonal/speed over the speed classes is at most 1e9 (the statistics stay finite).
+    position lies in the scenario's zone, and sensor ids are unique; no ground sensor (a type not
+    `elevated`), now or in the history, stands on a cell whose centre lies in a building; and with
+    obstacles the estimator is `exact`. Rules no schema can state (each a 422 whose `detail` names the
+    field): the zone's width and height are whole multiples of `cell_size`, and the lattice has at most
+    4,000,000 cells; every source lies strictly outside the zone; a source without `direction` is beside
+    exactly one edge of the zone or gives a `heading` whose half-plane holds the zone; some direction of
+    each source's cone enters the zone; `target_speed` is required when some source gives no `speeds`; a
+    source's weights sum to a finite number; Σ rate·diagonal/speed over the speed classes is at most 1e9
+    (the statistics stay finite); each obstacle's polygon is convex, with no repeated vertex and no
+    three consecutive ones collinear, and not wholly outside the zone; no source lies inside a building,
+    and some direction of each source's cone enters the zone before any building.
 
     Args:
         body (PlanRequestById | PlanRequestWithScenario): Body of `POST /v1/plan`: the body of
@@ -153,13 +157,17 @@ def sync(
     required. An inline scenario whose precomputation is predicted above the server's synchronous budget
     is refused with 422: register it instead. A plan predicted above `--max-plan-ms` is refused with 422
     too. Rules no schema can state (each a 422 whose `detail` names the field): every sensor and history
-    position lies in the scenario's zone, and sensor ids are unique. Rules no schema can state (each a
-    422 whose `detail` names the field): the zone's width and height are whole multiples of `cell_size`,
-    and the lattice has at most 4,000,000 cells; every source lies strictly outside the zone; a source
-    without `direction` is beside exactly one edge of the zone or gives a `heading` whose half-plane
-    holds the zone; some direction of each source's cone enters the zone; `target_speed` is required
-    when some source gives no `speeds`; a source's weights sum to a finite number; and Σ
-    rate·diagonal/speed over the speed classes is at most 1e9 (the statistics stay finite).
+    position lies in the scenario's zone, and sensor ids are unique; no ground sensor (a type not
+    `elevated`), now or in the history, stands on a cell whose centre lies in a building; and with
+    obstacles the estimator is `exact`. Rules no schema can state (each a 422 whose `detail` names the
+    field): the zone's width and height are whole multiples of `cell_size`, and the lattice has at most
+    4,000,000 cells; every source lies strictly outside the zone; a source without `direction` is beside
+    exactly one edge of the zone or gives a `heading` whose half-plane holds the zone; some direction of
+    each source's cone enters the zone; `target_speed` is required when some source gives no `speeds`; a
+    source's weights sum to a finite number; Σ rate·diagonal/speed over the speed classes is at most 1e9
+    (the statistics stay finite); each obstacle's polygon is convex, with no repeated vertex and no
+    three consecutive ones collinear, and not wholly outside the zone; no source lies inside a building,
+    and some direction of each source's cone enters the zone before any building.
 
     Args:
         body (PlanRequestById | PlanRequestWithScenario): Body of `POST /v1/plan`: the body of
@@ -193,13 +201,17 @@ async def asyncio_detailed(
     required. An inline scenario whose precomputation is predicted above the server's synchronous budget
     is refused with 422: register it instead. A plan predicted above `--max-plan-ms` is refused with 422
     too. Rules no schema can state (each a 422 whose `detail` names the field): every sensor and history
-    position lies in the scenario's zone, and sensor ids are unique. Rules no schema can state (each a
-    422 whose `detail` names the field): the zone's width and height are whole multiples of `cell_size`,
-    and the lattice has at most 4,000,000 cells; every source lies strictly outside the zone; a source
-    without `direction` is beside exactly one edge of the zone or gives a `heading` whose half-plane
-    holds the zone; some direction of each source's cone enters the zone; `target_speed` is required
-    when some source gives no `speeds`; a source's weights sum to a finite number; and Σ
-    rate·diagonal/speed over the speed classes is at most 1e9 (the statistics stay finite).
+    position lies in the scenario's zone, and sensor ids are unique; no ground sensor (a type not
+    `elevated`), now or in the history, stands on a cell whose centre lies in a building; and with
+    obstacles the estimator is `exact`. Rules no schema can state (each a 422 whose `detail` names the
+    field): the zone's width and height are whole multiples of `cell_size`, and the lattice has at most
+    4,000,000 cells; every source lies strictly outside the zone; a source without `direction` is beside
+    exactly one edge of the zone or gives a `heading` whose half-plane holds the zone; some direction of
+    each source's cone enters the zone; `target_speed` is required when some source gives no `speeds`; a
+    source's weights sum to a finite number; Σ rate·diagonal/speed over the speed classes is at most 1e9
+    (the statistics stay finite); each obstacle's polygon is convex, with no repeated vertex and no
+    three consecutive ones collinear, and not wholly outside the zone; no source lies inside a building,
+    and some direction of each source's cone enters the zone before any building.
 
     Args:
         body (PlanRequestById | PlanRequestWithScenario): Body of `POST /v1/plan`: the body of
@@ -236,13 +248,17 @@ async def asyncio(
     required. An inline scenario whose precomputation is predicted above the server's synchronous budget
     is refused with 422: register it instead. A plan predicted above `--max-plan-ms` is refused with 422
     too. Rules no schema can state (each a 422 whose `detail` names the field): every sensor and history
-    position lies in the scenario's zone, and sensor ids are unique. Rules no schema can state (each a
-    422 whose `detail` names the field): the zone's width and height are whole multiples of `cell_size`,
-    and the lattice has at most 4,000,000 cells; every source lies strictly outside the zone; a source
-    without `direction` is beside exactly one edge of the zone or gives a `heading` whose half-plane
-    holds the zone; some direction of each source's cone enters the zone; `target_speed` is required
-    when some source gives no `speeds`; a source's weights sum to a finite number; and Σ
-    rate·diagonal/speed over the speed classes is at most 1e9 (the statistics stay finite).
+    position lies in the scenario's zone, and sensor ids are unique; no ground sensor (a type not
+    `elevated`), now or in the history, stands on a cell whose centre lies in a building; and with
+    obstacles the estimator is `exact`. Rules no schema can state (each a 422 whose `detail` names the
+    field): the zone's width and height are whole multiples of `cell_size`, and the lattice has at most
+    4,000,000 cells; every source lies strictly outside the zone; a source without `direction` is beside
+    exactly one edge of the zone or gives a `heading` whose half-plane holds the zone; some direction of
+    each source's cone enters the zone; `target_speed` is required when some source gives no `speeds`; a
+    source's weights sum to a finite number; Σ rate·diagonal/speed over the speed classes is at most 1e9
+    (the statistics stay finite); each obstacle's polygon is convex, with no repeated vertex and no
+    three consecutive ones collinear, and not wholly outside the zone; no source lies inside a building,
+    and some direction of each source's cone enters the zone before any building.
 
     Args:
         body (PlanRequestById | PlanRequestWithScenario): Body of `POST /v1/plan`: the body of

@@ -109,7 +109,9 @@ def sync_detailed(
     id is 404 whatever the body (and one still being precomputed 503). A plan whose cost the server
     predicts above its limit (`--max-plan-ms`, 2 s of CPU by default) is refused with 422 before any
     work starts. Rules no schema can state (each a 422 whose `detail` names the field): every sensor and
-    history position lies in the scenario's zone, and sensor ids are unique.
+    history position lies in the scenario's zone, and sensor ids are unique; no ground sensor (a type
+    not `elevated`), now or in the history, stands on a cell whose centre lies in a building; and with
+    obstacles the estimator is `exact`.
 
     Args:
         id (str):
@@ -149,7 +151,9 @@ def sync(
     id is 404 whatever the body (and one still being precomputed 503). A plan whose cost the server
     predicts above its limit (`--max-plan-ms`, 2 s of CPU by default) is refused with 422 before any
     work starts. Rules no schema can state (each a 422 whose `detail` names the field): every sensor and
-    history position lies in the scenario's zone, and sensor ids are unique.
+    history position lies in the scenario's zone, and sensor ids are unique; no ground sensor (a type
+    not `elevated`), now or in the history, stands on a cell whose centre lies in a building; and with
+    obstacles the estimator is `exact`.
 
     Args:
         id (str):
@@ -184,7 +188,9 @@ async def asyncio_detailed(
     id is 404 whatever the body (and one still being precomputed 503). A plan whose cost the server
     predicts above its limit (`--max-plan-ms`, 2 s of CPU by default) is refused with 422 before any
     work starts. Rules no schema can state (each a 422 whose `detail` names the field): every sensor and
-    history position lies in the scenario's zone, and sensor ids are unique.
+    history position lies in the scenario's zone, and sensor ids are unique; no ground sensor (a type
+    not `elevated`), now or in the history, stands on a cell whose centre lies in a building; and with
+    obstacles the estimator is `exact`.
 
     Args:
         id (str):
@@ -222,7 +228,9 @@ async def asyncio(
     id is 404 whatever the body (and one still being precomputed 503). A plan whose cost the server
     predicts above its limit (`--max-plan-ms`, 2 s of CPU by default) is refused with 422 before any
     work starts. Rules no schema can state (each a 422 whose `detail` names the field): every sensor and
-    history position lies in the scenario's zone, and sensor ids are unique.
+    history position lies in the scenario's zone, and sensor ids are unique; no ground sensor (a type
+    not `elevated`), now or in the history, stands on a cell whose centre lies in a building; and with
+    obstacles the estimator is `exact`.
 
     Args:
         id (str):

@@ -119,8 +119,10 @@ def sync_detailed(
     4,000,000 cells; every source lies strictly outside the zone; a source without `direction` is beside
     exactly one edge of the zone or gives a `heading` whose half-plane holds the zone; some direction of
     each source's cone enters the zone; `target_speed` is required when some source gives no `speeds`; a
-    source's weights sum to a finite number; and Σ rate·diagonal/speed over the speed classes is at most
-    1e9 (the statistics stay finite).
+    source's weights sum to a finite number; Σ rate·diagonal/speed over the speed classes is at most 1e9
+    (the statistics stay finite); each obstacle's polygon is convex, with no repeated vertex and no
+    three consecutive ones collinear, and not wholly outside the zone; no source lies inside a building,
+    and some direction of each source's cone enters the zone before any building.
 
     Args:
         body (ScenarioSpec): A scenario as clients send it.
@@ -167,8 +169,10 @@ def sync(
     4,000,000 cells; every source lies strictly outside the zone; a source without `direction` is beside
     exactly one edge of the zone or gives a `heading` whose half-plane holds the zone; some direction of
     each source's cone enters the zone; `target_speed` is required when some source gives no `speeds`; a
-    source's weights sum to a finite number; and Σ rate·diagonal/speed over the speed classes is at most
-    1e9 (the statistics stay finite).
+    source's weights sum to a finite number; Σ rate·diagonal/speed over the speed classes is at most 1e9
+    (the statistics stay finite); each obstacle's polygon is convex, with no repeated vertex and no
+    three consecutive ones collinear, and not wholly outside the zone; no source lies inside a building,
+    and some direction of each source's cone enters the zone before any building.
 
     Args:
         body (ScenarioSpec): A scenario as clients send it.
@@ -210,8 +214,10 @@ async def asyncio_detailed(
     4,000,000 cells; every source lies strictly outside the zone; a source without `direction` is beside
     exactly one edge of the zone or gives a `heading` whose half-plane holds the zone; some direction of
     each source's cone enters the zone; `target_speed` is required when some source gives no `speeds`; a
-    source's weights sum to a finite number; and Σ rate·diagonal/speed over the speed classes is at most
-    1e9 (the statistics stay finite).
+    source's weights sum to a finite number; Σ rate·diagonal/speed over the speed classes is at most 1e9
+    (the statistics stay finite); each obstacle's polygon is convex, with no repeated vertex and no
+    three consecutive ones collinear, and not wholly outside the zone; no source lies inside a building,
+    and some direction of each source's cone enters the zone before any building.
 
     Args:
         body (ScenarioSpec): A scenario as clients send it.
@@ -256,8 +262,10 @@ async def asyncio(
     4,000,000 cells; every source lies strictly outside the zone; a source without `direction` is beside
     exactly one edge of the zone or gives a `heading` whose half-plane holds the zone; some direction of
     each source's cone enters the zone; `target_speed` is required when some source gives no `speeds`; a
-    source's weights sum to a finite number; and Σ rate·diagonal/speed over the speed classes is at most
-    1e9 (the statistics stay finite).
+    source's weights sum to a finite number; Σ rate·diagonal/speed over the speed classes is at most 1e9
+    (the statistics stay finite); each obstacle's polygon is convex, with no repeated vertex and no
+    three consecutive ones collinear, and not wholly outside the zone; no source lies inside a building,
+    and some direction of each source's cone enters the zone before any building.
 
     Args:
         body (ScenarioSpec): A scenario as clients send it.

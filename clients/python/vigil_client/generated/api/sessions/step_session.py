@@ -125,7 +125,9 @@ def sync_detailed(
     layout), and is not made again: send one to retry safely after a lost answer, a timeout or a 503.
     The last step's key with another body is refused with 422 (`idempotency-key-reused`). Rules no
     schema can state (each a 422 whose `detail` names the field): every sensor and history position lies
-    in the scenario's zone, and sensor ids are unique.
+    in the scenario's zone, and sensor ids are unique; no ground sensor (a type not `elevated`), now or
+    in the history, stands on a cell whose centre lies in a building; and with obstacles the estimator
+    is `exact`.
 
     Args:
         id (str):
@@ -174,7 +176,9 @@ def sync(
     layout), and is not made again: send one to retry safely after a lost answer, a timeout or a 503.
     The last step's key with another body is refused with 422 (`idempotency-key-reused`). Rules no
     schema can state (each a 422 whose `detail` names the field): every sensor and history position lies
-    in the scenario's zone, and sensor ids are unique.
+    in the scenario's zone, and sensor ids are unique; no ground sensor (a type not `elevated`), now or
+    in the history, stands on a cell whose centre lies in a building; and with obstacles the estimator
+    is `exact`.
 
     Args:
         id (str):
@@ -218,7 +222,9 @@ async def asyncio_detailed(
     layout), and is not made again: send one to retry safely after a lost answer, a timeout or a 503.
     The last step's key with another body is refused with 422 (`idempotency-key-reused`). Rules no
     schema can state (each a 422 whose `detail` names the field): every sensor and history position lies
-    in the scenario's zone, and sensor ids are unique.
+    in the scenario's zone, and sensor ids are unique; no ground sensor (a type not `elevated`), now or
+    in the history, stands on a cell whose centre lies in a building; and with obstacles the estimator
+    is `exact`.
 
     Args:
         id (str):
@@ -265,7 +271,9 @@ async def asyncio(
     layout), and is not made again: send one to retry safely after a lost answer, a timeout or a 503.
     The last step's key with another body is refused with 422 (`idempotency-key-reused`). Rules no
     schema can state (each a 422 whose `detail` names the field): every sensor and history position lies
-    in the scenario's zone, and sensor ids are unique.
+    in the scenario's zone, and sensor ids are unique; no ground sensor (a type not `elevated`), now or
+    in the history, stands on a cell whose centre lies in a building; and with obstacles the estimator
+    is `exact`.
 
     Args:
         id (str):
