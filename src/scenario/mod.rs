@@ -677,8 +677,15 @@ fn building_cells(obstacles: &Obstacles, cols: i32, rows: i32, cell_size: f64) -
 
 /// Refuses source `i` when no direction of its cone reaches the zone's
 /// interior before a building ends its flight (a source inside a
-/// building among them), checked on a grid of
-/// [`OBSTACLE_STATS_RAYS_PER_PI`] rays per π.
+/// building among them).
+///
+/// Exact: whether a direction reaches the zone first changes only at the
+/// angles of the buildings' vertices, the zone's corners and the points
+/// where a building's edge crosses the zone's edge (where the edges a ray
+/// meets, or which of them comes first, change), so one direction
+/// between each two of those angles decides for all of them. The grid of
+/// [`OBSTACLE_STATS_RAYS_PER_PI`] rays per π this check once was is
+/// tried too, so that no spec it took is refused now.
 fn reaches_zone(
     i: usize,
     source: &Source,
@@ -692,13 +699,27 @@ fn reaches_zone(
         ));
     }
     let (lo, hi) = source.cone;
-    let n = ((hi - lo) / std::f64::consts::PI * OBSTACLE_STATS_RAYS_PER_PI as f64).ceil() as usize;
-    let reaches = (0..n.max(1)).any(|m| {
-        let d = source.direction(lo + (hi - lo) * (m as f64 + 0.5) / n.max(1) as f64);
+    let reaches_at = |alpha: f64| {
+        let d = source.direction(alpha);
         let inv = Point::new(1.0 / d.x, 1.0 / d.y);
         zone.ray(source.pos, d, inv)
             .is_some_and(|(a, b)| b > a && obstacles.stop(source.pos, d) > a)
-    });
+    };
+    let n = ((hi - lo) / std::f64::consts::PI * OBSTACLE_STATS_RAYS_PER_PI as f64).ceil() as usize;
+    let on_grid =
+        (0..n.max(1)).any(|m| reaches_at(lo + (hi - lo) * (m as f64 + 0.5) / n.max(1) as f64));
+    let reaches = on_grid || {
+        let mut angles: Vec<f64> = critical_points(obstacles, zone)
+            .into_iter()
+            .map(|p| source.angle_to(p))
+            .filter(|a| *a > lo && *a < hi)
+            .chain([lo, hi])
+            .collect();
+        angles.sort_by(f64::total_cmp);
+        angles
+            .windows(2)
+            .any(|w| w[1] > w[0] && reaches_at(0.5 * (w[0] + w[1])))
+    };
     if reaches {
         Ok(())
     } else {
@@ -707,6 +728,52 @@ fn reaches_zone(
             "every direction of its cone meets a building before the zone: no target it emits can enter",
         ))
     }
+}
+
+/// The buildings' vertices, the zone's corners, and the points where a
+/// building's edge crosses the zone's edge: the points at whose angles
+/// from a source [`reaches_zone`]'s answer may change.
+fn critical_points(obstacles: &Obstacles, zone: &Rect) -> Vec<Point> {
+    let corners = [
+        Point::new(zone.x0, zone.y0),
+        Point::new(zone.x1, zone.y0),
+        Point::new(zone.x1, zone.y1),
+        Point::new(zone.x0, zone.y1),
+    ];
+    let mut points = corners.to_vec();
+    for ob in obstacles
+        .list()
+        .iter()
+        .filter(|ob| ob.kind == ObstacleKind::Building)
+    {
+        let v = ob.polygon.vertices();
+        points.extend_from_slice(v);
+        for k in 0..v.len() {
+            let (p, q) = (v[k], v[(k + 1) % v.len()]);
+            for c in 0..4 {
+                if let Some(x) = segments_cross(p, q, corners[c], corners[(c + 1) % 4]) {
+                    points.push(x);
+                }
+            }
+        }
+    }
+    points
+}
+
+/// The point where segments `[p, q]` and `[a, b]` cross, if they do at one
+/// point.
+fn segments_cross(p: Point, q: Point, a: Point, b: Point) -> Option<Point> {
+    let (rx, ry) = (q.x - p.x, q.y - p.y);
+    let (sx, sy) = (b.x - a.x, b.y - a.y);
+    let den = rx * sy - ry * sx;
+    if den == 0.0 {
+        return None;
+    }
+    let (wx, wy) = (a.x - p.x, a.y - p.y);
+    let t = (wx * sy - wy * sx) / den;
+    let u = (wx * ry - wy * rx) / den;
+    ((0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u))
+        .then(|| Point::new(p.x + t * rx, p.y + t * ry))
 }
 
 /// Id of a canonical spec: `s-` and the first 16 hex digits of the SHA-256 of

@@ -330,6 +330,23 @@ async fn malformed_obstacles_are_refused_naming_the_field() {
     let across =
         with(json!([{"polygon": [[90.0, 10.0], [120.0, 10.0], [120.0, 30.0], [90.0, 30.0]]}]));
     register(&app, &across).await;
+    // A source whose cone enters the zone only through a gap of 1e-3
+    // radians between two buildings (no ray of a grid of 2048 per π goes
+    // through it) is valid; with the gap closed it is not.
+    let gap = |upper: f64| {
+        json!({"zone": {"width": 200, "height": 100}, "cell_size": 10,
+            "fov": {"shape": "square", "half_width": 25}, "target_speed": 5,
+            "sources": [{"x": -1, "y": 50, "rate": 0.4}],
+            "obstacles": [
+                {"polygon": [[-0.5, -50], [5, -50], [5, 49.997], [-0.5, 49.99975]]},
+                {"polygon": [[-0.5, 150], [-0.5, upper], [5, upper + 0.00275], [5, 150]]}]})
+    };
+    register(&app, &gap(50.00025)).await;
+    assert_validation(
+        app.post_json("/v1/scenarios", &gap(49.9)).await,
+        "sources[0]",
+    )
+    .await;
     // So is one that reaches as far as the limit; it takes in no cell
     // centre beyond its edges (the one at x = 55 is half a unit out).
     let far = with(json!([{"polygon": [[44.0, -1e9], [54.5, -1e9], [54.5, 25.0], [44.0, 25.0]]}]));
