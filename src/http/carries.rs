@@ -1,6 +1,8 @@
 //! Each replica's sessions' carries ([`Carry`]): what a step kept for its
 //! session's next step, held by session id under a byte budget
-//! (`--session-carry-mb`), the least recently used dropped first.
+//! (`--session-carry-mb`), the least recently used dropped first, and
+//! none longer than a session lives idle (`--session-ttl-s`). The
+//! sessions' store drops a session's carry when the session ends here.
 //!
 //! A carry is a cache: it is checked against the step's state before use
 //! (see [`Carry`]), so one that another replica's steps made stale, or that
@@ -9,6 +11,7 @@
 
 use std::collections::{BTreeMap, HashMap};
 use std::sync::{Mutex, PoisonError};
+use std::time::{Duration, Instant};
 
 use crate::estimator::Carry;
 use crate::metric_names;
@@ -17,6 +20,7 @@ use crate::metric_names;
 #[derive(Debug)]
 pub struct Carries {
     limit: usize,
+    ttl: Duration,
     held: Mutex<Held>,
 }
 
@@ -32,6 +36,7 @@ struct Held {
 
 struct Kept {
     tick: u64,
+    at: Instant,
     carry: Carry,
     bytes: usize,
 }
@@ -46,10 +51,13 @@ impl std::fmt::Debug for Kept {
 }
 
 impl Carries {
-    /// No carries, at most `limit` bytes of them (0: none kept).
-    pub fn new(limit: usize) -> Self {
+    /// No carries, at most `limit` bytes of them (0: none kept), none
+    /// kept longer than `ttl` (its session's idle time to live: a session
+    /// that has not stepped for that long is gone).
+    pub fn new(limit: usize, ttl: Duration) -> Self {
         Self {
             limit,
+            ttl,
             held: Mutex::new(Held::default()),
         }
     }
@@ -63,6 +71,7 @@ impl Carries {
     /// Session `id`'s carry, taken out (an empty one if none is held).
     pub fn take(&self, id: &str) -> Carry {
         let mut held = self.lock();
+        self.expire(&mut held);
         let Some(kept) = held.by_id.remove(id) else {
             return Carry::new();
         };
@@ -78,6 +87,7 @@ impl Carries {
     pub fn keep(&self, id: &str, carry: Carry) {
         let bytes = carry.memory_bytes();
         let mut held = self.lock();
+        self.expire(&mut held);
         if let Some(old) = held.by_id.remove(id) {
             held.order.remove(&old.tick);
             held.bytes -= old.bytes;
@@ -95,7 +105,12 @@ impl Carries {
             let tick = held.tick;
             held.order.insert(tick, id.to_string());
             held.by_id
-                .insert(id.to_string(), Kept { tick, carry, bytes });
+                .insert(id.to_string(), Kept {
+                    tick,
+                    at: Instant::now(),
+                    carry,
+                    bytes,
+                });
             held.bytes += bytes;
         }
         Self::report(&held);
@@ -106,9 +121,31 @@ impl Carries {
         drop(self.take(id));
     }
 
+    /// Drops the carries kept longer ago than the time to live (the
+    /// oldest come first).
+    fn expire(&self, held: &mut Held) {
+        let now = Instant::now();
+        while let Some((_, id)) = held.order.first_key_value() {
+            let Some(kept) = held.by_id.get(id) else {
+                break;
+            };
+            if now.duration_since(kept.at) <= self.ttl {
+                break;
+            }
+            if let Some((_, id)) = held.order.pop_first()
+                && let Some(gone) = held.by_id.remove(&id)
+            {
+                held.bytes -= gone.bytes;
+            }
+        }
+    }
+
     /// Bytes held now.
     pub fn bytes(&self) -> usize {
-        self.lock().bytes
+        let mut held = self.lock();
+        self.expire(&mut held);
+        Self::report(&held);
+        held.bytes
     }
 
     fn report(held: &Held) {
@@ -145,7 +182,8 @@ mod tests {
         let planner = Planner::new(builtins().remove(0));
         let one = carry(&planner, 150.0).memory_bytes();
         // Room for two carries of about this size, not three.
-        let carries = Carries::new(2 * one + one / 2);
+        let hour = Duration::from_secs(3600);
+        let carries = Carries::new(2 * one + one / 2, hour);
         carries.keep("a", carry(&planner, 150.0));
         carries.keep("b", carry(&planner, 160.0));
         assert!(carries.bytes() > one);
@@ -163,9 +201,16 @@ mod tests {
         carries.forget("a");
         assert_eq!(carries.bytes(), 0);
         // Nothing is kept past a budget smaller than one carry.
-        let none = Carries::new(one / 2);
+        let none = Carries::new(one / 2, hour);
         none.keep("a", carry(&planner, 150.0));
         assert!(none.take("a").is_empty());
         assert_eq!(none.bytes(), 0);
+        // Nor past the time to live.
+        let brief = Carries::new(4 * one, Duration::from_millis(50));
+        brief.keep("a", carry(&planner, 150.0));
+        assert!(brief.bytes() > 0);
+        std::thread::sleep(Duration::from_millis(80));
+        assert_eq!(brief.bytes(), 0);
+        assert!(brief.take("a").is_empty());
     }
 }

@@ -23,6 +23,7 @@ use std::time::{Duration, Instant};
 use axum::body::Bytes;
 use lru::LruCache;
 
+use super::carries::Carries;
 use super::error::ApiError;
 use crate::metric_names;
 use crate::planner::Planner;
@@ -126,12 +127,14 @@ pub struct SessionStore {
     /// With a database: the cache's bound, bytes.
     cache_bytes: usize,
     db: Option<PgStore>,
+    /// The sessions' carries: a session's goes when it ends here.
+    carries: Arc<Carries>,
 }
 
 impl SessionStore {
     /// Sessions in memory: at most `capacity`, each dropped after `ttl`
-    /// without a request.
-    pub fn new(ttl: Duration, capacity: usize) -> Self {
+    /// without a request, with their steps' `carries`.
+    pub fn new(ttl: Duration, capacity: usize, carries: Arc<Carries>) -> Self {
         Self {
             map: Mutex::new(Map {
                 lru: LruCache::unbounded(),
@@ -141,17 +144,24 @@ impl SessionStore {
             capacity: capacity.max(1),
             cache_bytes: usize::MAX,
             db: None,
+            carries,
         }
     }
 
     /// Sessions in database `db` (at most `capacity`, each dropped after
     /// `ttl` without a request), with a cache here of at most
-    /// `cache_bytes`.
-    pub fn with_database(ttl: Duration, capacity: usize, cache_bytes: usize, db: PgStore) -> Self {
+    /// `cache_bytes`, and their steps' `carries`.
+    pub fn with_database(
+        ttl: Duration,
+        capacity: usize,
+        cache_bytes: usize,
+        db: PgStore,
+        carries: Arc<Carries>,
+    ) -> Self {
         Self {
             cache_bytes,
             db: Some(db),
-            ..Self::new(ttl, capacity)
+            ..Self::new(ttl, capacity, carries)
         }
     }
 
@@ -177,8 +187,9 @@ impl SessionStore {
             if now.duration_since(entry.used) <= self.ttl {
                 break;
             }
-            if let Some((_, gone)) = map.lru.pop_lru() {
+            if let Some((id, gone)) = map.lru.pop_lru() {
                 map.bytes -= gone.bytes;
+                self.carries.forget(&id);
             }
             metrics::counter!(metric_names::SESSIONS_EVICTED_TOTAL, "reason" => "idle")
                 .increment(1);
@@ -210,11 +221,13 @@ impl SessionStore {
                 map.lru.len() > self.capacity
             })
         {
-            let Some((_, gone)) = map.lru.pop_lru() else {
+            let Some((id, gone)) = map.lru.pop_lru() else {
                 break;
             };
             map.bytes -= gone.bytes;
             if self.db.is_none() {
+                // The session is gone (in the database, only its cache).
+                self.carries.forget(&id);
                 metrics::counter!(metric_names::SESSIONS_EVICTED_TOTAL, "reason" => "capacity")
                     .increment(1);
             }
@@ -234,7 +247,9 @@ impl SessionStore {
         map.bytes = map.bytes - old + bytes;
     }
 
+    /// Drops session `id` (and its carry): it ended.
     fn forget(&self, id: &str) {
+        self.carries.forget(id);
         let mut map = self.lock();
         if let Some(gone) = map.lru.pop(id) {
             map.bytes -= gone.bytes;
@@ -521,6 +536,7 @@ impl SessionStore {
             let removed = map.lru.pop(id);
             if let Some(gone) = &removed {
                 map.bytes -= gone.bytes;
+                self.carries.forget(id);
             }
             metrics::gauge!(metric_names::SESSIONS_LIVE).set(map.lru.len() as f64);
             return removed.map(|_| ()).ok_or_else(|| self.not_found(id));
@@ -553,4 +569,58 @@ fn encode_spec(planner: &Planner) -> Result<Vec<u8>, ApiError> {
     ciborium::into_writer(&planner.scenario.spec, &mut bytes)
         .map_err(|e| ApiError::Internal(format!("encoding a scenario's spec: {e}")))?;
     Ok(bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cancel::CancelToken;
+    use crate::estimator::Carry;
+    use crate::planner::{PlanInput, PlanRequest};
+    use crate::scenario::builtins;
+    use crate::session::SessionSettings;
+
+    /// A carry of a plan on `planner` with one step of history.
+    fn carry(planner: &Planner) -> Carry {
+        let req: PlanRequest = serde_json::from_value(serde_json::json!({
+            "sensors": [{"id": "a", "x": 150.0, "y": 150.0}],
+            "history": [[{"x": 150.0, "y": 140.0}]],
+        }))
+        .expect("a plan request");
+        let input = PlanInput::new(&planner.scenario, &req).expect("valid");
+        let mut carry = Carry::new();
+        planner
+            .plan_carried(&input, &CancelToken::never(), &mut carry)
+            .expect("never cancelled");
+        carry
+    }
+
+    /// A session dropped for the count, for idle time or by a delete
+    /// takes its carry with it.
+    #[tokio::test]
+    async fn a_session_that_ends_drops_its_carry() {
+        let planner = Arc::new(Planner::new(builtins().remove(0)));
+        let carries = Arc::new(Carries::new(usize::MAX, Duration::from_secs(3600)));
+        let store = SessionStore::new(Duration::from_millis(300), 1, carries.clone());
+        let open = async || {
+            let session = Session::new(planner.clone(), SessionSettings::default());
+            let (id, _) = store.create(session).await.expect("in memory");
+            carries.keep(&id, carry(&planner));
+            id
+        };
+        let first = open().await;
+        assert!(carries.bytes() > 0);
+        // The second takes the first's place (a count of 1).
+        let second = open().await;
+        assert!(carries.take(&first).is_empty());
+        let kept = carries.bytes();
+        assert!(kept > 0);
+        // Idle past the time to live: gone at the next request.
+        tokio::time::sleep(Duration::from_millis(400)).await;
+        assert!(store.checkout(&second).is_err());
+        assert_eq!(carries.bytes(), 0);
+        let third = open().await;
+        store.remove(&third).await.expect("live");
+        assert_eq!(carries.bytes(), 0);
+    }
 }

@@ -448,6 +448,5 @@ pub async fn delete(
     Path(id): Path<String>,
 ) -> Result<StatusCode, ApiError> {
     state.sessions.remove(&id).await?;
-    state.carries.forget(&id);
     Ok(StatusCode::NO_CONTENT)
 }

@@ -41,14 +41,19 @@ impl AppState {
     /// bounds on precomputation).
     pub fn with_settings(registry: Registry, settings: Settings) -> Self {
         registry.set_limits(settings.job_limits());
+        let carries = Arc::new(Carries::new(
+            settings.session_carry_bytes,
+            settings.session_ttl,
+        ));
         Self {
             registry: Arc::new(registry),
             cache: Arc::new(PlannerCache::new(settings.cache_bytes)),
             sessions: Arc::new(SessionStore::new(
                 settings.session_ttl,
                 settings.max_sessions,
+                carries.clone(),
             )),
-            carries: Arc::new(Carries::new(settings.session_carry_bytes)),
+            carries,
             settings: Arc::new(settings),
         }
     }
@@ -75,15 +80,18 @@ impl AppState {
         let registry =
             Registry::with_database(store.clone(), settings.job_limits(), settings.cache_bytes);
         registry.watch();
+        let state = Self::with_settings(registry, settings);
+        let s = &state.settings;
         let sessions = SessionStore::with_database(
-            settings.session_ttl,
-            settings.max_sessions,
-            settings.session_cache_bytes,
+            s.session_ttl,
+            s.max_sessions,
+            s.session_cache_bytes,
             store,
+            state.carries.clone(),
         );
         Self {
             sessions: Arc::new(sessions),
-            ..Self::with_settings(registry, settings)
+            ..state
         }
     }
 }
