@@ -56,6 +56,10 @@ pub const MAX_NO_GO: usize = 256;
 pub const MAX_OBSTACLES: usize = 64;
 /// Fewest vertices of an obstacle's polygon.
 pub const MIN_OBSTACLE_VERTICES: usize = 3;
+/// Largest magnitude of a source's coordinates: a source may lie far from
+/// the zone, but not where the statistics' distances overflow (a source at
+/// 1.7e308 gave every plan NaN values).
+pub const MAX_SOURCE_COORDINATE: f64 = 1e12;
 /// Most vertices of an obstacle's polygon.
 pub const MAX_OBSTACLE_VERTICES: usize = 32;
 /// Largest magnitude of an obstacle vertex's coordinates: a polygon may

@@ -104,13 +104,15 @@ impl Carries {
             held.tick += 1;
             let tick = held.tick;
             held.order.insert(tick, id.to_string());
-            held.by_id
-                .insert(id.to_string(), Kept {
+            held.by_id.insert(
+                id.to_string(),
+                Kept {
                     tick,
                     at: Instant::now(),
                     carry,
                     bytes,
-                });
+                },
+            );
             held.bytes += bytes;
         }
         Self::report(&held);

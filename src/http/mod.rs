@@ -30,7 +30,8 @@ macro_rules! spec_rules {
     () => {
         " Rules no schema can state (each a 422 whose `detail` names the field): the zone's \
         width and height are whole multiples of `cell_size`, and the lattice has at most \
-        4,000,000 cells; every source lies strictly outside the zone; a source without \
+        4,000,000 cells; every source lies strictly outside the zone, its coordinates within \
+        ±1e12; a source without \
         `direction` is beside exactly one edge of the zone or gives a `heading` whose \
         half-plane holds the zone; some direction of each source's cone enters the zone; \
         `target_speed` is required when some source gives no `speeds`; a source's weights sum \

@@ -14,7 +14,7 @@ use utoipa::ToSchema;
 
 use super::input::ValidationError;
 use crate::geometry::{Point, Rect};
-use crate::limits::MAX_SPEED_CLASSES;
+use crate::limits::{MAX_SOURCE_COORDINATE, MAX_SPEED_CLASSES};
 
 /// Direction a source's takeoff half-plane faces.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, ToSchema)]
@@ -246,11 +246,16 @@ pub(super) fn validate(
     target_speed: Option<f64>,
 ) -> Result<Validated, ValidationError> {
     let f = |name: &str| format!("sources[{i}].{name}");
-    if !s.x.is_finite() {
-        return Err(ValidationError::new(f("x"), "must be finite"));
-    }
-    if !s.y.is_finite() {
-        return Err(ValidationError::new(f("y"), "must be finite"));
+    for (axis, v) in [("x", s.x), ("y", s.y)] {
+        if !v.is_finite() {
+            return Err(ValidationError::new(f(axis), "must be finite"));
+        }
+        if v.abs() > MAX_SOURCE_COORDINATE {
+            return Err(ValidationError::new(
+                f(axis),
+                format!("must lie within ±{MAX_SOURCE_COORDINATE:e}"),
+            ));
+        }
     }
     if !(s.rate.is_finite() && s.rate >= 0.0) {
         return Err(ValidationError::new(

@@ -259,6 +259,23 @@ async fn invalid_specs_are_422() {
         "sources[1].rate",
     )
     .await;
+    // So far that the statistics' distances would overflow (every plan's
+    // values were NaN, sent as null).
+    spec_rejected(
+        &app,
+        |s| s["sources"][0]["x"] = json!(-1.7e308),
+        "sources[0].x",
+    )
+    .await;
+    spec_rejected(&app, |s| s["sources"][1]["y"] = json!(2e12), "sources[1].y").await;
+    // At the limit, the values are numbers.
+    let mut far = small_spec();
+    far["sources"][0]["x"] = json!(-1e12);
+    let body = json!({"scenario": far, "sensors": [{"id": "a", "x": 15.0, "y": 45.0}]});
+    let res = app.post_json("/v1/plan", &body).await;
+    assert_eq!(res.status(), reqwest::StatusCode::OK);
+    let plan: Value = res.json().await.unwrap();
+    assert!(plan["expected_detections"].is_f64(), "{plan}");
     spec_rejected(&app, |s| s["horizon"] = json!(0), "horizon").await;
     spec_rejected(&app, |s| s["horizon"] = json!(13), "horizon").await;
     spec_rejected(&app, |s| s["name"] = json!("n".repeat(201)), "name").await;

@@ -113,13 +113,13 @@ def sync_detailed(
     speed (king moves) that free cells allow, from the sensor's own cell. Rules no schema can state
     (each a 422 whose `detail` names the field): the zone's width and height are whole multiples of
     `cell_size`, and the lattice has at most 4,000,000 cells; every source lies strictly outside the
-    zone; a source without `direction` is beside exactly one edge of the zone or gives a `heading` whose
-    half-plane holds the zone; some direction of each source's cone enters the zone; `target_speed` is
-    required when some source gives no `speeds`; a source's weights sum to a finite number; Σ
-    rate·diagonal/speed over the speed classes is at most 1e9 (the statistics stay finite); each
-    obstacle's polygon is convex, with no repeated vertex and no three consecutive ones collinear, and
-    not wholly outside the zone; no source lies inside a building, and some direction of each source's
-    cone enters the zone before any building.
+    zone, its coordinates within ±1e12; a source without `direction` is beside exactly one edge of the
+    zone or gives a `heading` whose half-plane holds the zone; some direction of each source's cone
+    enters the zone; `target_speed` is required when some source gives no `speeds`; a source's weights
+    sum to a finite number; Σ rate·diagonal/speed over the speed classes is at most 1e9 (the statistics
+    stay finite); each obstacle's polygon is convex, with no repeated vertex and no three consecutive
+    ones collinear, and not wholly outside the zone; no source lies inside a building, and some
+    direction of each source's cone enters the zone before any building.
 
     Args:
         body (EvaluateRequestById | EvaluateRequestWithScenario): Body of `POST /v1/evaluate`: the
@@ -164,13 +164,13 @@ def sync(
     speed (king moves) that free cells allow, from the sensor's own cell. Rules no schema can state
     (each a 422 whose `detail` names the field): the zone's width and height are whole multiples of
     `cell_size`, and the lattice has at most 4,000,000 cells; every source lies strictly outside the
-    zone; a source without `direction` is beside exactly one edge of the zone or gives a `heading` whose
-    half-plane holds the zone; some direction of each source's cone enters the zone; `target_speed` is
-    required when some source gives no `speeds`; a source's weights sum to a finite number; Σ
-    rate·diagonal/speed over the speed classes is at most 1e9 (the statistics stay finite); each
-    obstacle's polygon is convex, with no repeated vertex and no three consecutive ones collinear, and
-    not wholly outside the zone; no source lies inside a building, and some direction of each source's
-    cone enters the zone before any building.
+    zone, its coordinates within ±1e12; a source without `direction` is beside exactly one edge of the
+    zone or gives a `heading` whose half-plane holds the zone; some direction of each source's cone
+    enters the zone; `target_speed` is required when some source gives no `speeds`; a source's weights
+    sum to a finite number; Σ rate·diagonal/speed over the speed classes is at most 1e9 (the statistics
+    stay finite); each obstacle's polygon is convex, with no repeated vertex and no three consecutive
+    ones collinear, and not wholly outside the zone; no source lies inside a building, and some
+    direction of each source's cone enters the zone before any building.
 
     Args:
         body (EvaluateRequestById | EvaluateRequestWithScenario): Body of `POST /v1/evaluate`: the
@@ -210,13 +210,13 @@ async def asyncio_detailed(
     speed (king moves) that free cells allow, from the sensor's own cell. Rules no schema can state
     (each a 422 whose `detail` names the field): the zone's width and height are whole multiples of
     `cell_size`, and the lattice has at most 4,000,000 cells; every source lies strictly outside the
-    zone; a source without `direction` is beside exactly one edge of the zone or gives a `heading` whose
-    half-plane holds the zone; some direction of each source's cone enters the zone; `target_speed` is
-    required when some source gives no `speeds`; a source's weights sum to a finite number; Σ
-    rate·diagonal/speed over the speed classes is at most 1e9 (the statistics stay finite); each
-    obstacle's polygon is convex, with no repeated vertex and no three consecutive ones collinear, and
-    not wholly outside the zone; no source lies inside a building, and some direction of each source's
-    cone enters the zone before any building.
+    zone, its coordinates within ±1e12; a source without `direction` is beside exactly one edge of the
+    zone or gives a `heading` whose half-plane holds the zone; some direction of each source's cone
+    enters the zone; `target_speed` is required when some source gives no `speeds`; a source's weights
+    sum to a finite number; Σ rate·diagonal/speed over the speed classes is at most 1e9 (the statistics
+    stay finite); each obstacle's polygon is convex, with no repeated vertex and no three consecutive
+    ones collinear, and not wholly outside the zone; no source lies inside a building, and some
+    direction of each source's cone enters the zone before any building.
 
     Args:
         body (EvaluateRequestById | EvaluateRequestWithScenario): Body of `POST /v1/evaluate`: the
@@ -259,13 +259,13 @@ async def asyncio(
     speed (king moves) that free cells allow, from the sensor's own cell. Rules no schema can state
     (each a 422 whose `detail` names the field): the zone's width and height are whole multiples of
     `cell_size`, and the lattice has at most 4,000,000 cells; every source lies strictly outside the
-    zone; a source without `direction` is beside exactly one edge of the zone or gives a `heading` whose
-    half-plane holds the zone; some direction of each source's cone enters the zone; `target_speed` is
-    required when some source gives no `speeds`; a source's weights sum to a finite number; Σ
-    rate·diagonal/speed over the speed classes is at most 1e9 (the statistics stay finite); each
-    obstacle's polygon is convex, with no repeated vertex and no three consecutive ones collinear, and
-    not wholly outside the zone; no source lies inside a building, and some direction of each source's
-    cone enters the zone before any building.
+    zone, its coordinates within ±1e12; a source without `direction` is beside exactly one edge of the
+    zone or gives a `heading` whose half-plane holds the zone; some direction of each source's cone
+    enters the zone; `target_speed` is required when some source gives no `speeds`; a source's weights
+    sum to a finite number; Σ rate·diagonal/speed over the speed classes is at most 1e9 (the statistics
+    stay finite); each obstacle's polygon is convex, with no repeated vertex and no three consecutive
+    ones collinear, and not wholly outside the zone; no source lies inside a building, and some
+    direction of each source's cone enters the zone before any building.
 
     Args:
         body (EvaluateRequestById | EvaluateRequestWithScenario): Body of `POST /v1/evaluate`: the
