@@ -66,10 +66,9 @@ impl<'de> Deserialize<'de> for EvaluateRequest {
         let paths = fields
             .remove("paths")
             .ok_or_else(|| D::Error::missing_field("paths"))?;
-        let paths =
-            serde_json::from_value(paths).map_err(|e| D::Error::custom(format!("paths: {e}")))?;
-        let plan =
-            serde_json::from_value(serde_json::Value::Object(fields)).map_err(D::Error::custom)?;
+        let paths = crate::json_path::from_value(&paths, "paths").map_err(D::Error::custom)?;
+        let plan = crate::json_path::from_value(&serde_json::Value::Object(fields), "")
+            .map_err(D::Error::custom)?;
         Ok(Self { plan, paths })
     }
 }

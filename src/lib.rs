@@ -33,6 +33,7 @@ pub mod evaluate;
 pub mod fit;
 pub mod geometry;
 pub mod http;
+mod json_path;
 pub mod limits;
 pub mod metric_names;
 pub mod obstacle;

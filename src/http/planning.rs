@@ -7,7 +7,6 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use axum::Extension;
-use serde::Deserialize as _;
 
 use super::config::INLINE_PLAN_MS;
 use super::error::ApiError;
@@ -171,8 +170,8 @@ pub(super) async fn with_scenario<T: serde::de::DeserializeOwned>(
     };
     let scenario_id = fields.remove("scenario_id");
     let inline = fields.remove("scenario");
-    let req: T = serde_json::from_value(serde_json::Value::Object(fields))
-        .map_err(|e| ApiError::MalformedBody(e.to_string()))?;
+    let req: T = crate::json_path::from_value(&serde_json::Value::Object(fields), "")
+        .map_err(ApiError::MalformedBody)?;
     let planner = resolve_scenario(state, start, scenario_id, inline).await?;
     Ok((planner, req))
 }
@@ -199,18 +198,8 @@ pub(super) async fn resolve_scenario(
             ));
         }
         (None, Some(spec)) => {
-            let spec = ScenarioSpec::deserialize(&spec).map_err(|_| {
-                // Again, only to name the field (as `POST /v1/scenarios`
-                // does): the path's bookkeeping slows every parse.
-                let detail = match serde_path_to_error::deserialize::<_, ScenarioSpec>(&spec) {
-                    Err(e) if e.path().iter().next().is_some() => {
-                        format!("scenario.{}: {}", e.path(), e.inner())
-                    }
-                    Err(e) => format!("scenario: {}", e.inner()),
-                    Ok(_) => "scenario: not a valid scenario spec".to_owned(),
-                };
-                ApiError::MalformedBody(detail)
-            })?;
+            let spec: ScenarioSpec =
+                crate::json_path::from_value(&spec, "scenario").map_err(ApiError::MalformedBody)?;
             let scenario = Scenario::new(spec).map_err(|mut e| {
                 e.field = format!("scenario.{}", e.field);
                 e

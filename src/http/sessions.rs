@@ -133,8 +133,9 @@ pub async fn create(
     };
     let scenario_id = fields.remove("scenario_id");
     let inline = fields.remove("scenario");
-    let settings: SessionSettings = serde_json::from_value(serde_json::Value::Object(fields))
-        .map_err(|e| ApiError::MalformedBody(e.to_string()))?;
+    let settings: SessionSettings =
+        crate::json_path::from_value(&serde_json::Value::Object(fields), "")
+            .map_err(ApiError::MalformedBody)?;
     settings.history_len()?;
     if let Some(h) = &settings.horizon {
         h.check("horizon", 1..=MAX_HORIZON)?;

@@ -580,3 +580,38 @@ async fn overflowing_target_models_are_422() {
     )
     .await;
 }
+
+/// A body's fields read apart from it (`/v1/plan`'s and `/v1/evaluate`'s
+/// request besides its scenario, a session's settings, evaluate's paths)
+/// name the failing field's path, as a whole body's do.
+#[tokio::test]
+async fn type_errors_in_split_bodies_name_the_field() {
+    let app = spawn_app().await;
+    let sensor = json!([{"id": "a", "x": "75", "y": 75}]);
+    let cases = [
+        (
+            "/v1/plan",
+            json!({"scenario_id": "paper-v10", "sensors": sensor}),
+            "sensors[0].x: invalid type",
+        ),
+        (
+            "/v1/sessions",
+            json!({"scenario_id": "paper-v10", "horizon": "3"}),
+            "horizon: invalid type",
+        ),
+        (
+            "/v1/evaluate",
+            json!({"scenario_id": "paper-v10", "sensors": [{"id": "a", "x": 75, "y": 75}],
+                "paths": [{"sensor": "a", "path": [{"col": "6", "row": 7}]}]}),
+            "paths[0].path[0].col: invalid type",
+        ),
+    ];
+    for (url, body, says) in cases {
+        assert_problem(
+            app.post_json(url, &body).await,
+            reqwest::StatusCode::BAD_REQUEST,
+            says,
+        )
+        .await;
+    }
+}
