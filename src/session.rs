@@ -236,7 +236,20 @@ impl StepRequest {
     /// differ only in layout, field order or number spelling have one
     /// digest.
     pub fn digest(&self) -> [u8; 32] {
-        let json = serde_json::to_vec(self).unwrap_or_default();
+        // Integers keep their spelling (a fraction is refused naming it):
+        // a retry may spell 3 as 3.0.
+        let mut req = self.clone();
+        for n in [
+            &mut req.horizon,
+            &mut req.min_separation,
+            &mut req.budget_ms,
+        ]
+        .into_iter()
+        .flatten()
+        {
+            *n = n.canonical();
+        }
+        let json = serde_json::to_vec(&req).unwrap_or_default();
         Sha256::digest(&json).into()
     }
 }
@@ -583,6 +596,22 @@ impl Session {
 mod tests {
     use super::*;
     use crate::scenario::builtins;
+
+    /// A retry's body may lay out, order and spell its numbers otherwise,
+    /// integers included; another value is another step.
+    #[test]
+    fn a_step_digest_reads_values_not_spelling() {
+        let parse = |text: &str| -> StepRequest { serde_json::from_str(text).expect("a step") };
+        let one =
+            parse(r#"{"sensors": [{"id": "a", "x": 75, "y": 75}], "horizon": 3, "budget_ms": 20}"#);
+        let same = parse(
+            r#"{"budget_ms": 2e1, "horizon": 3.0, "sensors": [{"y": 7.5e1, "x": 75.0, "id": "a"}]}"#,
+        );
+        assert_eq!(one.digest(), same.digest());
+        let other =
+            parse(r#"{"sensors": [{"id": "a", "x": 75, "y": 75}], "horizon": 4, "budget_ms": 20}"#);
+        assert_ne!(one.digest(), other.digest());
+    }
 
     fn session(history: usize) -> Session {
         let planner = Arc::new(Planner::new(builtins().remove(0)));

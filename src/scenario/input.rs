@@ -64,6 +64,16 @@ impl Integer {
         &self.0
     }
 
+    /// The same value spelled as an integer when it is a whole number
+    /// (`3.0` and `3e0` become `3`), else as given.
+    pub fn canonical(&self) -> Self {
+        match (self.get(), self.signed()) {
+            (Some(v), _) => Integer(v.into()),
+            (None, Some(v)) => Integer(v.into()),
+            _ => self.clone(),
+        }
+    }
+
     /// The value if it lies in `range`, else a validation error for
     /// `field` that states the range.
     pub fn check(
