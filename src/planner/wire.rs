@@ -298,8 +298,9 @@ pub struct PlanResponse {
     pub expected_by_step: Vec<f64>,
     /// With the `exact` estimator: an upper bound on what the best joint
     /// plan could expect, and how far this plan may be from it (see the
-    /// README's "certified plan quality"). Absent for `paper`, whose total
-    /// is not a coverage.
+    /// README's "certified plan quality"). Absent (never `null`) for
+    /// `paper`, whose total is not a coverage, and for a request with
+    /// `"certify": false`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bound: Option<Bound>,
     /// With `coordination: joint` and the `exact` estimator: its rounds
