@@ -401,13 +401,24 @@ impl Planner {
         carry: Option<&mut Carry>,
     ) -> Result<Chosen<'_>, Cancelled> {
         let s = &self.scenario;
+        // Nothing to carry for the paper's estimator, which keeps no seen
+        // sets. First detections plan statelessly too: their searches,
+        // not the estimator's preparation, are their work, and a carried
+        // step's sums (the same terms in another order) broke exact ties
+        // between paths otherwise than the stateless plan does, which
+        // their coverage makes common.
+        let carry = match carry {
+            Some(carry)
+                if input.estimator == EstimatorKind::Paper
+                    || input.objective == Objective::FirstDetections =>
+            {
+                *carry = Carry::new();
+                None
+            }
+            carry => carry,
+        };
         Ok(match input.estimator {
             EstimatorKind::Paper => Chosen::Paper({
-                if let Some(carry) = carry {
-                    // Nothing to carry: the paper's estimator keeps no
-                    // seen sets.
-                    *carry = Carry::new();
-                }
                 PaperEstimator::new(
                     s,
                     &self.stats,

@@ -27,8 +27,9 @@
 //! made it: a step checks that its history is the carry's looks, one step
 //! older, and starts over otherwise, so a stale or foreign carry gives the
 //! stateless answer, never a wrong one. It applies to certain looks without
-//! obstacles (the windows also need the one-window grid); other sessions
-//! plan statelessly.
+//! obstacles (the windows also need the one-window grid), for the
+//! detections objective; other steps plan statelessly (the planner clears
+//! the carry of a first-detections step).
 
 use std::collections::VecDeque;
 
@@ -45,7 +46,7 @@ pub enum CarryUse {
     /// It had none, or one of another state, and started over.
     Rebuilt,
     /// The carry does not apply to it (uncertain looks, buildings, the
-    /// paper's estimator), which planned statelessly.
+    /// paper's estimator, first detections), which planned statelessly.
     #[default]
     Stateless,
 }
