@@ -9,8 +9,8 @@ use crate::limits::MAX_IDEMPOTENCY_KEY_CHARS;
 use crate::scenario::ValidationError;
 
 /// Description of the `{id}` path parameter.
-pub const SCENARIO_ID: &str = "Scenario id: a built-in (`paper-v10`, `paper-v15`, `site-gates`) or one returned by \
-    `POST /v1/scenarios`.";
+pub const SCENARIO_ID: &str = "Scenario id: a built-in (`paper-v10`, `paper-v15`, `site-gates`, `site-fleet`, \
+    `site-campus`) or one returned by `POST /v1/scenarios`.";
 
 fn problem(e: ApiError) -> Problem {
     e.problem()
@@ -367,3 +367,18 @@ pub struct Timeout(pub Problem);
     )
 )]
 pub struct InvalidFitRequest(pub Problem);
+
+#[cfg(test)]
+mod tests {
+    /// The `{id}` parameter's description names every built-in.
+    #[test]
+    fn the_scenario_id_lists_every_builtin() {
+        for s in crate::scenario::builtins() {
+            assert!(
+                super::SCENARIO_ID.contains(&format!("`{}`", s.id)),
+                "{} is not listed",
+                s.id
+            );
+        }
+    }
+}
