@@ -302,6 +302,13 @@ impl Polygon {
     }
 }
 
+/// Below this share of the coordinates' size a point test counts a sight
+/// line as touching an obstacle, not crossing it: rounding (about 1e-16
+/// of the size) puts a point on a line that grazes a vertex on either side
+/// of the shadow's edge. Only point tests use it; intervals along rays
+/// differ by it in measure zero.
+const GRAZE: f64 = 1e-9;
+
 /// The points hidden from a viewpoint by one obstacle.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Shadow {
@@ -312,12 +319,17 @@ pub enum Shadow {
 }
 
 impl Shadow {
-    /// True when `q` is hidden.
+    /// True when `q` is hidden: strictly inside every half-plane, by more
+    /// than [`GRAZE`] of its coordinates' size (a point on a line that
+    /// grazes a vertex is seen, whichever side rounding puts it).
     #[inline]
     fn hides(&self, q: Point) -> bool {
         match self {
             Shadow::Everything => true,
-            Shadow::Planes(planes) => planes.iter().all(|h| h.slack(q) > 0.0),
+            Shadow::Planes(planes) => {
+                let tol = GRAZE * (1.0 + q.x.abs().max(q.y.abs()));
+                planes.iter().all(|h| h.slack(q) > tol)
+            }
         }
     }
 
@@ -474,13 +486,20 @@ impl Obstacles {
         first_entry(self.list.iter(), p, d)
     }
 
-    /// True when the open segment `(p, q)` meets no obstacle's interior.
+    /// True when the open segment `(p, q)` meets no obstacle's interior
+    /// (over more than [`GRAZE`] of the coordinates' size: a segment that
+    /// grazes a vertex is clear, whichever side rounding puts it).
     pub fn clear(&self, p: Point, q: Point) -> bool {
         let d = Point::new(q.x - p.x, q.y - p.y);
+        let (len, size) = (
+            d.x.hypot(d.y),
+            p.x.abs().max(p.y.abs()).max(q.x.abs()).max(q.y.abs()),
+        );
+        let tol = GRAZE * (1.0 + size);
         self.list.iter().all(|ob| {
             ob.polygon
                 .line_interior(p, d)
-                .is_none_or(|(t0, t1)| t1 <= 0.0 || t0 >= 1.0)
+                .is_none_or(|(t0, t1)| (t1.min(1.0) - t0.max(0.0)) * len <= tol)
         })
     }
 

@@ -298,3 +298,34 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    /// A sight line through the vertex that bounds a polygon's shadow on
+    /// either side only touches the polygon: every point past the vertex
+    /// on it is seen and its segment clear, though rounding puts those
+    /// points on either side of the shadow's edge.
+    #[test]
+    fn lines_that_graze_a_vertex_are_clear(poly in polygons(), p in point()) {
+        prop_assume!(!poly.contains_closed(p));
+        let obs = one(poly.clone(), ObstacleKind::Screen);
+        let sight = obs.sight(p, &whole()).expect("in view");
+        let rel = |v: Point| Point::new(v.x - p.x, v.y - p.y);
+        let cross = |a: Point, b: Point| a.x * b.y - a.y * b.x;
+        let vs = poly.vertices();
+        for &v in vs {
+            // v bounds the shadow when every other vertex lies on one side
+            // of the line from p through it.
+            let sides: Vec<f64> = vs.iter().filter(|&&w| w != v).map(|&w| cross(rel(v), rel(w))).collect();
+            if !(sides.iter().all(|&c| c > 0.0) || sides.iter().all(|&c| c < 0.0)) {
+                continue;
+            }
+            for s in [1.25, 1.5, 2.0, 3.0] {
+                let q = Point::new(p.x + s * (v.x - p.x), p.y + s * (v.y - p.y));
+                prop_assert!(sight.sees(q), "{:?} → {:?} by {:?}", p, q, v);
+                prop_assert!(obs.clear(p, q), "{:?} → {:?} by {:?}", p, q, v);
+            }
+        }
+    }
+}
