@@ -134,7 +134,7 @@ UNSCHEMATISABLE = [
         "a fit window's sensors, under the same rules as a plan's sensors (zone, types, ground, unique ids)",
     ),
     (
-        r"^steps\[\d+\]\.detections\[\d+\]: \(.*\) lies outside every field of view of this step",
+        r"^steps\[\d+\]\.detections\[\d+\]: \(.*\) lies (outside every field of view|behind an obstacle from every look) of this step",
         "a detection must lie in a field of view of its step: a relation with the sensors of the same step and the scenario's types",
     ),
     (
@@ -150,7 +150,7 @@ UNSCHEMATISABLE = [
         "a bound on the predicted precompute time of the scenario named or sent in the body (src/cost.rs)",
     ),
     (
-        r"^detections\[\d+\](\.id: required when the session learns rates|: \(.*\) lies outside every field of view|\.id: track id .* (jumps|is detected twice))",
+        r"^detections\[\d+\](\.id: required when the session learns rates|: \(.*\) lies (outside every field of view|behind an obstacle from every look)|\.id: track id .* (jumps|is detected twice))",
         "a learning session's detections: an id (required only when the session, created earlier, learns), in a field of view of the step's sensors, moving no faster than a target",
     ),
     (

@@ -82,9 +82,11 @@ pub struct SpeedSpec {
            "speeds": [{"speed": 1.5, "weight": 3.0}, {"speed": 12.0, "weight": 1.0}]})
 ))]
 pub struct SourceSpec {
-    /// East coordinate.
+    /// East coordinate, within ±1e12 (`MAX_SOURCE_COORDINATE`).
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub x: f64,
-    /// North coordinate.
+    /// North coordinate, within ±1e12.
+    #[schema(minimum = -1e12, maximum = 1e12)]
     pub y: f64,
     /// Poisson rate, targets per step.
     #[schema(minimum = 0)]

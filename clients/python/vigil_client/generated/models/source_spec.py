@@ -23,8 +23,8 @@ class SourceSpec:
 
     Attributes:
         rate (float): Poisson rate, targets per step.
-        x (float): East coordinate.
-        y (float): North coordinate.
+        x (float): East coordinate, within ±1e12 (`MAX_SOURCE_COORDINATE`).
+        y (float): North coordinate, within ±1e12.
         direction (float | None | Unset): Centre of the takeoff cone, degrees counter-clockwise from east
             (east 0, north 90, west 180, south 270); the heading's by default.
         heading (Heading | None | Unset):
