@@ -156,7 +156,7 @@ impl Carries {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::cancel::CancelToken;
     use crate::planner::{PlanInput, PlanRequest, Planner};
@@ -164,7 +164,7 @@ mod tests {
 
     /// The carry of a plan on `paper-v10` with one step of history, the
     /// sensor at `x`.
-    fn carry(planner: &Planner, x: f64) -> Carry {
+    pub(crate) fn carry(planner: &Planner, x: f64) -> Carry {
         let req: PlanRequest = serde_json::from_value(serde_json::json!({
             "sensors": [{"id": "a", "x": x, "y": 150.0}],
             "history": [[{"x": x, "y": 140.0}]],

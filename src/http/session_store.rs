@@ -378,12 +378,7 @@ impl SessionStore {
             )
             .await?;
         let Some(row) = row else {
-            self.forget(id);
-            if db.drop_expired_session(id, self.ttl).await.unwrap_or(false) {
-                metrics::counter!(metric_names::SESSIONS_EVICTED_TOTAL, "reason" => "idle")
-                    .increment(1);
-            }
-            return Err(self.not_found(id));
+            return Err(self.gone(db, id).await);
         };
         if let (Some(key), Some(answer)) = (key, row.replay) {
             return replay(key, row.replay_digest.as_deref(), Bytes::from(answer));
@@ -502,12 +497,18 @@ impl SessionStore {
         if db.touch_session(id, self.ttl).await? {
             return Ok(());
         }
+        Err(self.gone(db, id).await)
+    }
+
+    /// Session `id`, found not live in the database: drops it here (and
+    /// its row, if it expired, counted as idle) and returns its 404.
+    async fn gone(&self, db: &PgStore, id: &str) -> ApiError {
         self.forget(id);
         if db.drop_expired_session(id, self.ttl).await.unwrap_or(false) {
             metrics::counter!(metric_names::SESSIONS_EVICTED_TOTAL, "reason" => "idle")
                 .increment(1);
         }
-        Err(self.not_found(id))
+        self.not_found(id)
     }
 
     /// Marks session `id` used now (after a step that failed, which
@@ -573,27 +574,10 @@ fn encode_spec(planner: &Planner) -> Result<Vec<u8>, ApiError> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::carries::tests::carry;
     use super::*;
-    use crate::cancel::CancelToken;
-    use crate::estimator::Carry;
-    use crate::planner::{PlanInput, PlanRequest};
     use crate::scenario::builtins;
     use crate::session::SessionSettings;
-
-    /// A carry of a plan on `planner` with one step of history.
-    fn carry(planner: &Planner) -> Carry {
-        let req: PlanRequest = serde_json::from_value(serde_json::json!({
-            "sensors": [{"id": "a", "x": 150.0, "y": 150.0}],
-            "history": [[{"x": 150.0, "y": 140.0}]],
-        }))
-        .expect("a plan request");
-        let input = PlanInput::new(&planner.scenario, &req).expect("valid");
-        let mut carry = Carry::new();
-        planner
-            .plan_carried(&input, &CancelToken::never(), &mut carry)
-            .expect("never cancelled");
-        carry
-    }
 
     /// A session dropped for the count, for idle time or by a delete
     /// takes its carry with it.
@@ -605,7 +589,7 @@ mod tests {
         let open = async || {
             let session = Session::new(planner.clone(), SessionSettings::default());
             let (id, _) = store.create(session).await.expect("in memory");
-            carries.keep(&id, carry(&planner));
+            carries.keep(&id, carry(&planner, 150.0));
             id
         };
         let first = open().await;
