@@ -582,3 +582,41 @@ fn exposure_on_the_scenarios_rays_matches_a_fine_grid() {
         }
     }
 }
+
+/// Two sensors of one uncertain type on one cell take two looks, each
+/// detecting independently (docs/model.md), as plans count them: two looks
+/// of p 0.4 miss a target with probability 0.36, as one look of p 0.64 with
+/// the same field of view does, so a window of such pairs has the exposure
+/// of a window of the single sensors. (The pair was once counted as one
+/// look, which understated its exposure and overstated the rates.)
+#[test]
+fn co_located_uncertain_sensors_add_exposure() {
+    let mut spec = yard(false);
+    let fov = spec["fov"].clone();
+    spec["sensor_types"] = json!({
+        "p40": {"fov": fov, "p_detect": 0.4},
+        "p64": {"fov": fov, "p_detect": 0.64}
+    });
+    let s = scenario(spec);
+    let at = |types: &[&str], x: f64| -> Vec<SensorIn> {
+        types
+            .iter()
+            .enumerate()
+            .map(|(i, ty)| SensorIn {
+                id: Id::Number((i as u64).into()),
+                x,
+                y: 95.0,
+                sensor_type: Some(ty.to_string()),
+            })
+            .collect()
+    };
+    let exposure = |types: &[&str]| {
+        let steps: Vec<Vec<SensorIn>> = (0..6).map(|t| at(types, 25.0 + 20.0 * t as f64)).collect();
+        WindowLooks::new(&s, &looks_of(&s, &steps)).exposure(0)
+    };
+    let (pair, one) = (exposure(&["p40", "p40"]), exposure(&["p64"]));
+    for (j, (a, b)) in pair.iter().zip(&one).enumerate() {
+        assert!(*b > 0.1, "source {j}: {b}");
+        assert!((a - b).abs() < 1e-9 * b, "source {j}: pair {a}, one {b}");
+    }
+}

@@ -671,3 +671,68 @@ fn paper_estimator_scales_by_p_detect() {
     }
     assert!(compared > 50);
 }
+
+/// Every look detects independently of the others (docs/model.md), so two
+/// sensors of one uncertain type on one cell take two looks, now, in the
+/// history and in the plan. Two looks of p 0.5 miss a target with
+/// probability 0.25, as one look of p 0.75 with the same field of view
+/// does: a pair of `half` sensors that stand and move together scores what
+/// one `tq` sensor does, for both objectives. (Their looks were once
+/// merged into one, now and in the history: the pair then scored more.)
+#[test]
+fn co_located_uncertain_looks_detect_independently() {
+    let mut spec = paper_spec(10.0);
+    let ty = |p: f64| SensorTypeSpec {
+        fov: spec.fov,
+        speed: None,
+        p_detect: Some(p),
+        elevated: None,
+    };
+    spec.sensor_types = Some(BTreeMap::from([
+        ("half".to_owned(), ty(0.5)),
+        ("tq".to_owned(), ty(0.75)),
+    ]));
+    let planner = Planner::new(Scenario::new(spec).expect("valid"));
+    let path =
+        serde_json::json!([{"col": 6, "row": 7}, {"col": 5, "row": 7}, {"col": 4, "row": 7}]);
+    let score = |types: &[&str], objective: &str| {
+        let at = |x: f64, y: f64| -> Vec<serde_json::Value> {
+            types
+                .iter()
+                .map(|t| serde_json::json!({"x": x, "y": y, "type": t}))
+                .collect()
+        };
+        let sensors: Vec<serde_json::Value> = types
+            .iter()
+            .enumerate()
+            .map(|(i, t)| serde_json::json!({"id": i, "x": 75, "y": 75, "type": t}))
+            .collect();
+        let paths: Vec<serde_json::Value> = (0..types.len())
+            .map(|i| serde_json::json!({"sensor": i, "path": path}))
+            .collect();
+        let req: vigil::evaluate::EvaluateRequest = serde_json::from_value(serde_json::json!({
+            "sensors": sensors,
+            "history": [at(85.0, 75.0), at(95.0, 85.0), at(95.0, 95.0)],
+            "objective": objective,
+            "paths": paths,
+        }))
+        .expect("a valid request");
+        let cancel = vigil::cancel::CancelToken::default();
+        planner
+            .evaluate_request(&req, &cancel)
+            .expect("valid")
+            .expect("not cancelled")
+            .expected_detections
+    };
+    for objective in ["detections", "first_detections"] {
+        let (pair, one) = (
+            score(&["half", "half"], objective),
+            score(&["tq"], objective),
+        );
+        assert!(one > 0.1, "{objective}: {one}");
+        assert!(
+            (pair - one).abs() < 1e-9 * one,
+            "{objective}: two half looks {pair}, one tq look {one}"
+        );
+    }
+}

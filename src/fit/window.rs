@@ -11,7 +11,7 @@ use crate::limits::{
     DEFAULT_FIT_DISTANCE_TOLERANCE, DEFAULT_FIT_SPEED_TOLERANCE, MAX_FIT_DETECTIONS, MAX_FIT_STEPS,
     MAX_SENSORS,
 };
-use crate::planner::{Id, SensorIn, place};
+use crate::planner::{Id, SensorIn, place, step_looks};
 use crate::scenario::{Look, Scenario, ValidationError};
 
 /// A target's first detection in a window (or a session's life).
@@ -130,7 +130,7 @@ impl TrackBook {
             ));
         }
         let mut ids = HashSet::new();
-        let mut looks = Vec::with_capacity(sensors.len());
+        let mut places = Vec::with_capacity(sensors.len());
         for (i, sensor) in sensors.iter().enumerate() {
             if !ids.insert(sensor.id.key()) {
                 return Err(ValidationError::new(
@@ -139,20 +139,19 @@ impl TrackBook {
                 ));
             }
             let name = || format!("{field}sensors[{i}]");
-            let (cell, ty) = place(s, &name, sensor.x, sensor.y, sensor.sensor_type.as_deref())?;
-            looks.push(s.look(ty, cell));
-        }
-        // Two sensors of one type on one cell take one look, as in a plan.
-        let mut distinct: Vec<Look> = Vec::with_capacity(looks.len());
-        for l in looks {
-            if !distinct.contains(&l) {
-                distinct.push(l);
-            }
+            places.push(place(
+                s,
+                &name,
+                sensor.x,
+                sensor.y,
+                sensor.sensor_type.as_deref(),
+            )?);
         }
         let looks = if whole_zone {
             vec![Look::certain(s.zone_region())]
         } else {
-            distinct
+            // As in a plan: a look each, repeats of certain ones left out.
+            step_looks(s, places.into_iter())
         };
         let fastest = s.max_speed() * (1.0 + tol.traceback.speed);
         let mut seen = HashSet::new();

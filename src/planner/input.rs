@@ -12,7 +12,7 @@ use crate::limits::{
     MAX_BUDGET_MS, MAX_HISTORY_POSITIONS, MAX_HISTORY_STEPS, MAX_SENSORS, MAX_TARGETS,
 };
 use crate::scenario::{
-    Cell, DEFAULT_TYPE, Scenario, ValidationError, check_horizon, check_min_separation,
+    Cell, DEFAULT_TYPE, Look, Scenario, ValidationError, check_horizon, check_min_separation,
 };
 
 /// A validated plan request.
@@ -139,6 +139,35 @@ pub(crate) fn place(
         )),
         None => Ok((c, ty)),
     }
+}
+
+/// The looks of one step's sensors at `places` (cell and type), in their
+/// order (the estimator reads the i-th look of each step as one sensor's
+/// track). Every look detects independently of the others, so two sensors
+/// of one type on one cell take two looks, unless the type is certain
+/// (`p_detect` 1): the second then detects nothing the first does not,
+/// and is left out.
+pub(crate) fn step_looks(s: &Scenario, places: impl Iterator<Item = (Cell, usize)>) -> Vec<Look> {
+    // As many as come, as a rule: one allocation, not one per doubling.
+    let mut kept: Vec<(Cell, usize)> = Vec::with_capacity(places.size_hint().0);
+    let mut seen = HashSet::new();
+    for place in places {
+        let repeat = s.types[place.1].p_detect >= 1.0
+            && if kept.len() < 64 {
+                // A scan for a fleet's few looks (cheaper than hashing
+                // each), a set past that.
+                kept.contains(&place)
+            } else {
+                if seen.is_empty() {
+                    seen.extend(kept.iter().copied());
+                }
+                !seen.insert(place)
+            };
+        if !repeat {
+            kept.push(place);
+        }
+    }
+    kept.into_iter().map(|(c, ty)| s.look(ty, c)).collect()
 }
 
 impl PlanInput {

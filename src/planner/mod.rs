@@ -10,7 +10,7 @@ pub mod planning;
 pub mod wire;
 
 pub use input::PlanInput;
-pub(crate) use input::{check_certify, check_estimator, check_objective, place};
+pub(crate) use input::{check_certify, check_estimator, check_objective, place, step_looks};
 pub(crate) use planning::Chosen;
 pub use planning::{PRECOMPUTED_FORMAT, Planner};
 pub use wire::*;

@@ -2,11 +2,10 @@
 //! [`Planner::plan`], which turns a validated request into coordinated
 //! T-step paths.
 
-use std::collections::HashSet;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
-use super::input::PlanInput;
+use super::input::{PlanInput, step_looks};
 use super::wire::*;
 use crate::cancel::{CancelToken, Cancelled, Progress};
 use crate::codec::{CodecError, Reader, Writer, expect_len};
@@ -494,24 +493,22 @@ impl Planner {
         let s = &self.scenario;
         let now = match input.observed {
             Observed::Zone => vec![Look::certain(s.zone_region())],
-            Observed::Sensors => dedup(
+            Observed::Sensors => step_looks(
+                s,
                 input
                     .starts
                     .iter()
                     .copied()
                     .zip(input.types.iter().copied()),
-            )
-            .into_iter()
-            .map(|(c, ty)| s.look(ty, c))
-            .collect(),
+            ),
         };
         std::iter::once(now)
-            .chain(input.history.iter().map(|step| {
-                dedup(step.iter().copied())
-                    .into_iter()
-                    .map(|(c, ty)| s.look(ty, c))
-                    .collect()
-            }))
+            .chain(
+                input
+                    .history
+                    .iter()
+                    .map(|step| step_looks(s, step.iter().copied())),
+            )
             .collect()
     }
 }
@@ -562,32 +559,6 @@ impl Chosen<'_> {
         fleet.full_searches = input.explain;
         f(&fleet)
     }
-}
-
-/// The looks (cell and type) without repeats, in their order (the
-/// estimator reads the i-th position of each step as one sensor's track).
-/// Two sensors of the same type on one cell take one look: they see the
-/// same targets at once.
-fn dedup(looks: impl Iterator<Item = (Cell, usize)>) -> Vec<(Cell, usize)> {
-    // As many as come, as a rule: one allocation, not one per doubling.
-    let mut kept: Vec<(Cell, usize)> = Vec::with_capacity(looks.size_hint().0);
-    let mut seen = HashSet::new();
-    for look in looks {
-        // A scan for a fleet's few looks (cheaper than hashing each), a
-        // set past that.
-        let new = if kept.len() < 64 {
-            !kept.contains(&look)
-        } else {
-            if seen.is_empty() {
-                seen.extend(kept.iter().copied());
-            }
-            seen.insert(look)
-        };
-        if new {
-            kept.push(look);
-        }
-    }
-    kept
 }
 
 #[cfg(test)]
