@@ -16,12 +16,13 @@ use utoipa::openapi::{Ref, RefOr};
 use utoipa::{Modify, OpenApi};
 
 use super::doc::bounds::Bounds;
+
 use super::doc::{
     BadPath, BuiltinScenario, InvalidEvaluateRequest, InvalidFitRequest,
     InvalidInlineEvaluateRequest, InvalidInlinePlanRequest, InvalidPlanRequest, InvalidScenario,
     InvalidSession, InvalidStep, MalformedBody, MalformedStep, NotReady, Overloaded,
-    PayloadTooLarge, QueueFull, ScenarioNotFound, SessionConflict, SessionNotFound, Timeout,
-    Unauthorized,
+    PayloadTooLarge, QueueFull, ScenarioNotFound, SessionBodies, SessionConflict, SessionNotFound,
+    Timeout, Unauthorized,
 };
 use super::error::Problem;
 use super::{evaluate, fit, health, middleware, plan, scenarios, sessions};
@@ -97,7 +98,7 @@ Every error is an RFC 9457 problem (`application/problem+json`, schema \
             Timeout,
         )
     ),
-    modifiers(&V1Stack, &Closed, &Bounds),
+    modifiers(&V1Stack, &Closed, &SessionBodies, &Bounds),
     tags(
         (name = "health", description = "Liveness."),
         (name = "scenarios", description = "Register, read and delete scenarios."),

@@ -433,6 +433,77 @@ fn inline_plan_request_extends_plan_request() {
     );
 }
 
+/// `POST /v1/sessions`' two body shapes take every field a session's
+/// settings parse (`SessionSettings`) and their scenario, by id or inline:
+/// a client generated from the document can ask for all of them (the
+/// shapes once lacked `learn_rates`, `tolerance`, `certify` and
+/// `objective`, which the server took).
+#[test]
+fn session_bodies_take_every_setting() {
+    let doc = document();
+    let schemas = &doc["components"]["schemas"];
+    let fields = |name: &str| -> Vec<String> {
+        let mut f: Vec<String> = schemas[name]["properties"]
+            .as_object()
+            .unwrap()
+            .keys()
+            .cloned()
+            .collect();
+        f.sort();
+        f
+    };
+    // Every field set: a field added to the settings fails to compile here.
+    let all = vigil::session::SessionSettings {
+        horizon: Some(3.into()),
+        estimator: Some(vigil::planner::EstimatorKind::Exact),
+        coordination: Some(vigil::coordination::Coordination::Priority),
+        observed: Some(vigil::planner::Observed::Sensors),
+        objective: Some(vigil::coordination::Objective::Detections),
+        min_separation: Some(0.into()),
+        history_steps: Some(16.into()),
+        certify: Some(true),
+        learn_rates: Some(true),
+        tolerance: Some(Default::default()),
+    };
+    let mut settings: Vec<String> = serde_json::to_value(&all)
+        .unwrap()
+        .as_object()
+        .unwrap()
+        .keys()
+        .cloned()
+        .collect();
+    settings.sort();
+    assert_eq!(fields("SessionSettings"), settings);
+    let checker = Checker { doc: &doc };
+    for (name, extra, value) in [
+        (
+            "SessionRequestById",
+            "scenario_id",
+            Value::from("paper-v10"),
+        ),
+        (
+            "SessionRequestWithScenario",
+            "scenario",
+            serde_json::to_value(vigil::scenario::paper_spec(10.0)).unwrap(),
+        ),
+    ] {
+        let mut expected = settings.clone();
+        expected.push(extra.to_owned());
+        expected.sort();
+        assert_eq!(fields(name), expected, "{name}");
+        assert_eq!(
+            schemas[name]["required"],
+            serde_json::json!([extra]),
+            "{name}"
+        );
+        assert_eq!(schemas[name]["additionalProperties"], false, "{name}");
+        let mut body = serde_json::to_value(&all).unwrap();
+        body[extra] = value;
+        let schema = serde_json::json!({"$ref": format!("#/components/schemas/{name}")});
+        assert!(checker.check(&schema, &body, "$").is_ok(), "{name}: {body}");
+    }
+}
+
 /// The checker above is strict enough to be worth trusting.
 #[test]
 fn the_schema_checker_rejects_mismatches() {

@@ -5,7 +5,9 @@
     reason = "schemas the document describes, never built: their size costs nothing"
 )]
 
-use utoipa::ToSchema;
+use utoipa::openapi::schema::Schema;
+use utoipa::openapi::{OpenApi, RefOr};
+use utoipa::{Modify, ToSchema};
 
 use crate::coordination::{Coordination, Objective};
 use crate::evaluate::SensorPathIn;
@@ -141,6 +143,9 @@ pub enum InlineEvaluateRequest {
     WithScenario(EvaluateRequestWithScenario),
 }
 
+/// The two shapes of the body of `POST /v1/sessions`: the scenario, by
+/// id or inline, and every field of [`SessionSettings`](crate::session::SessionSettings), which
+/// [`SessionBodies`] copies in from that schema so the three never drift.
 macro_rules! session_request_with {
     ($(#[$doc:meta])* $name:ident, $(#[$field_doc:meta])* $field:ident: $ty:ty) => {
         $(#[$doc])*
@@ -149,26 +154,34 @@ macro_rules! session_request_with {
         pub struct $name {
             $(#[$field_doc])*
             pub $field: $ty,
-            /// Horizon T of its steps; the scenario's by default.
-            #[schema(value_type = Option<u32>, minimum = 1)]
-            pub horizon: Option<Integer>,
-            /// Estimator of its steps; `exact` by default.
-            pub estimator: Option<EstimatorKind>,
-            /// Coordination of its steps; `priority` by default.
-            pub coordination: Option<Coordination>,
-            /// What the detections cover; `sensors` by default.
-            pub observed: Option<Observed>,
-            /// Minimum separation of its steps, cells (0..=16); the
-            /// scenario's by default.
-            #[schema(value_type = Option<u32>, minimum = 0)]
-            pub min_separation: Option<Integer>,
-            /// Steps of history kept (0..=128, 16 by default): the sensors'
-            /// past positions planned with, and how long a track lives
-            /// undetected.
-            #[schema(value_type = Option<u32>, minimum = 0)]
-            pub history_steps: Option<Integer>,
         }
     };
+}
+
+/// Copies every property of [`SessionSettings`](crate::session::SessionSettings)' schema into the bodies
+/// of `POST /v1/sessions`, after their scenario field.
+pub struct SessionBodies;
+
+impl Modify for SessionBodies {
+    fn modify(&self, doc: &mut OpenApi) {
+        let Some(components) = doc.components.as_mut() else {
+            return;
+        };
+        let Some(RefOr::T(Schema::Object(settings))) =
+            components.schemas.get("SessionSettings").cloned()
+        else {
+            return;
+        };
+        for name in ["SessionRequestById", "SessionRequestWithScenario"] {
+            if let Some(RefOr::T(Schema::Object(body))) = components.schemas.get_mut(name) {
+                for (field, schema) in &settings.properties {
+                    body.properties
+                        .entry(field.clone())
+                        .or_insert_with(|| schema.clone());
+                }
+            }
+        }
+    }
 }
 
 session_request_with!(
