@@ -349,7 +349,7 @@ pub fn fit_response() -> Value {
         "scenario": "paper-v10",
         "steps": 2,
         "sources": [
-            {"index": 0, "rate": 0.311, "interval": [0.0377, 0.867], "detected": 1.0, "exposure": 3.09},
+            {"index": 0, "rate": 0.311, "interval": [0.0376, 0.866], "detected": 1.0, "exposure": 3.10},
             {"index": 1, "rate": 0.191, "interval": [0.00483, 0.703], "detected": 0.0, "exposure": 1.91}
         ],
         "unexplained": []
