@@ -127,6 +127,18 @@ impl SessionSettings {
         Tolerances::new(s, self.tolerance.as_ref())
     }
 
+    /// With `learn_rates`, checks that a session on `s` can learn
+    /// ([`RateLearner::check`]).
+    ///
+    /// # Errors
+    /// A [`ValidationError`] naming `learn_rates`.
+    pub fn check_learning(&self, s: &Scenario) -> Result<(), ValidationError> {
+        if self.learn_rates == Some(true) {
+            RateLearner::check(s)?;
+        }
+        Ok(())
+    }
+
     /// Checks what can be checked before any step: `history_steps`, an
     /// `objective` the `estimator` cannot serve, and `certify: false` with
     /// `joint` (the rest is checked with every step's plan request). Gives

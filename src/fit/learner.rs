@@ -83,15 +83,41 @@ pub struct LearnerSnapshot {
 }
 
 impl RateLearner {
+    /// Steps of looks a learning session on `s` must keep: the longest a
+    /// target can stay in the zone (its diagonal at the slowest speed),
+    /// plus one.
+    pub fn memory_needed(s: &Scenario) -> f64 {
+        (s.width.hypot(s.height) / s.min_speed()).ceil() + 1.0
+    }
+
+    /// Checks that a session on `s` can learn: that the looks its slowest
+    /// targets need fit in [`MAX_LEARN_MEMORY_STEPS`]. Fewer would count a
+    /// target seen again after them as new, and overstate the exposure.
+    ///
+    /// # Errors
+    /// A [`ValidationError`] naming `learn_rates`.
+    pub fn check(s: &Scenario) -> Result<(), ValidationError> {
+        let needed = Self::memory_needed(s);
+        if needed > MAX_LEARN_MEMORY_STEPS as f64 {
+            return Err(ValidationError::new(
+                "learn_rates",
+                format!(
+                    "the slowest targets (speed {}) may stay {needed:.0} steps in the zone; a learning session keeps the looks of at most {MAX_LEARN_MEMORY_STEPS} steps and would count such a target seen again as new; fit windows (POST /v1/scenarios/{{id}}/fit) have no such limit",
+                    s.min_speed()
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// A learner with nothing observed: the scenario prior, and `base`'s
-    /// planner.
+    /// planner. A scenario that fails [`RateLearner::check`] keeps only
+    /// [`MAX_LEARN_MEMORY_STEPS`] steps of looks.
     /// With `whole_zone`, every step's detections are taken to cover the
     /// zone (a session's `observed: zone`).
     pub fn new(base: Arc<Planner>, tolerances: Tolerances, whole_zone: bool) -> Self {
         let s = &base.scenario;
-        let slowest = s.min_speed();
-        let diagonal = s.width.hypot(s.height);
-        let memory = ((diagonal / slowest).ceil() as usize + 1).min(MAX_LEARN_MEMORY_STEPS);
+        let memory = (Self::memory_needed(s).min(MAX_LEARN_MEMORY_STEPS as f64)) as usize;
         RateLearner {
             planner: base.clone(),
             memory,

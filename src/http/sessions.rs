@@ -150,6 +150,7 @@ pub async fn create(
         &planner.scenario,
     )?;
     settings.tolerances(&planner.scenario)?;
+    settings.check_learning(&planner.scenario)?;
     if settings.learn_rates == Some(true) {
         // A learning session precomputes its scenario again as its rates
         // move: only a scenario precomputed at once may learn.

@@ -293,3 +293,49 @@ async fn a_learning_session_told_of_every_target_learns_from_the_zone() {
         "{body}"
     );
 }
+
+/// A learning session keeps the looks of at most 1,000 steps: a scenario
+/// whose slowest targets stay longer in the zone (600 units at 0.5 a step:
+/// 1,202 steps) would count a target seen again after them as new, so it
+/// may not learn (422 naming `learn_rates`); at speed 1 it may.
+#[tokio::test]
+async fn a_session_learns_only_if_it_can_remember_a_crossing() {
+    let app = spawn_app().await;
+    let spec = |speed: f64| {
+        json!({
+            "zone": {"width": 600.0, "height": 20.0},
+            "cell_size": 10.0,
+            "fov": {"shape": "square", "half_width": 10.0},
+            "target_speed": speed,
+            "sources": [{"x": -1.0, "y": 10.0, "rate": 0.2, "direction": 0.0, "spread": 1.0}]
+        })
+    };
+    let slow = app
+        .post_json(
+            "/v1/sessions",
+            &json!({"scenario": spec(0.5), "learn_rates": true}),
+        )
+        .await;
+    let body = assert_problem(slow, StatusCode::UNPROCESSABLE_ENTITY, "learn_rates").await;
+    let detail = body["detail"].as_str().unwrap();
+    assert!(
+        detail.starts_with("learn_rates: ") && detail.contains("1202 steps"),
+        "{body}"
+    );
+    // Without learning, the same scenario opens a session.
+    json_body(
+        app.post_json("/v1/sessions", &json!({"scenario": spec(0.5)}))
+            .await,
+        StatusCode::CREATED,
+    )
+    .await;
+    json_body(
+        app.post_json(
+            "/v1/sessions",
+            &json!({"scenario": spec(1.0), "learn_rates": true}),
+        )
+        .await,
+        StatusCode::CREATED,
+    )
+    .await;
+}
