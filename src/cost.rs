@@ -89,7 +89,8 @@ mod reach;
 
 pub use first::{FIRST_MODEL, FirstTerms, first_terms};
 use reach::{
-    half, iterated_rounds, near_by_step, obstructed_share, rays_per_look, sensor_reach, source_rays,
+    half, iterated_rounds, near_by_step, obstructed_share, rays_per_look, repair_passes,
+    sensor_reach, source_rays,
 };
 
 use crate::coordination::{Coordination, Objective};
@@ -517,6 +518,12 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> PlanTerms {
             &[(1.0, 0.0), (1.0, 0.5), (rounds, 1.0), (1.0, 0.0)]
         }
     };
+    let mut passes = passes.to_vec();
+    // The separation's repair, as ranked searches.
+    let repairs = repair_passes(s, input);
+    if repairs > 0.0 {
+        passes.push((repairs, 0.5));
+    }
     let zone_area = s.width * s.height;
     let mean_half = me.iter().map(|m| m.1).sum::<f64>() * cs / n as f64;
     // Per step, for the windows: the reach blocks' bounding box, their
@@ -539,11 +546,11 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> PlanTerms {
         fov_rects += own;
         // (1 − a)^excluded per pass, the share of the targets no excluded
         // look holds (looks placed independently), kept as a product.
-        let mut base = [1.0; 4];
-        for (b, &(_, share)) in base.iter_mut().zip(passes) {
-            *b = (1.0 - a).max(0.0).powf(share);
-        }
-        let mut miss = [1.0; 4];
+        let base: Vec<f64> = passes
+            .iter()
+            .map(|&(_, share)| (1.0 - a).max(0.0).powf(share))
+            .collect();
+        let mut miss = vec![1.0; passes.len()];
         let mut e = 0.0;
         for step in 1..=big_t {
             let fresh = near[i * stride + step];

@@ -48,7 +48,8 @@
 //! That pass never revisits a higher-ranked sensor, which may corner a
 //! lower one (push it against the zone's edge, say) although it could
 //! have stood back. So while some pair is too close, a repair round (at
-//! most [`MAX_REPAIRS`]) takes the highest-ranked sensor in a violation
+//! most [`MAX_REPAIRS`], and [`MAX_REPAIR_SEARCHES_PER_SENSOR`] searches per
+//! sensor in all) takes the highest-ranked sensor in a violation
 //! whose search around *every* other path has fewer violations than its
 //! own, gives it that path, lets the ranks below it plan again in order,
 //! and keeps the result if fewer pairs are too close in all. The last
@@ -81,8 +82,8 @@ use certificate::Certifier;
 use fleet::path_slices;
 pub use fleet::{Fleet, SensorPlan, first_search_budget, path_moves, sensor_motion};
 pub use joint::{JointReport, JointSettings};
-pub use priority::MAX_REPAIRS;
 use priority::Ranking;
+pub use priority::{MAX_REPAIR_SEARCHES_PER_SENSOR, MAX_REPAIRS};
 pub use rounds::MAX_ROUNDS;
 
 /// How sensors' searches are coordinated.
@@ -140,6 +141,8 @@ pub struct Coordinated {
     pub rounds: usize,
     /// Repair rounds of the separation run (see the module docs).
     pub repairs: usize,
+    /// The searches those rounds made.
+    pub repair_searches: usize,
     /// Breaches of the minimum separation among the final paths.
     pub violations: Violations,
     /// The plan's certificate, for an order-independent (exact) estimator.
@@ -212,12 +215,12 @@ pub fn coordinate(
         independent: mode == Coordination::None,
     };
     let mut rounds = 0;
-    let mut repairs = 0;
+    let (mut repairs, mut repair_searches) = (0, 0);
     if mode != Coordination::None || d > 0 {
         ranking.priority_pass(&mut plans)?;
     }
     if d > 0 {
-        repairs = ranking.repair(&mut plans)?;
+        (repairs, repair_searches) = ranking.repair(&mut plans)?;
     }
     let order = ranking.order;
     if matches!(mode, Coordination::Iterated | Coordination::Joint) {
@@ -271,6 +274,7 @@ pub fn coordinate(
         by_step,
         rounds,
         repairs,
+        repair_searches,
         violations,
         bound,
         joint: report,

@@ -10,6 +10,12 @@ use crate::separation::{self, mark_too_close};
 /// Largest number of repair rounds of the separation.
 pub const MAX_REPAIRS: usize = 8;
 
+/// The repair rounds' searches, at most this many per sensor in all (a
+/// trial under way finishes, at most one more per sensor): a crowded fleet
+/// can otherwise search about n² times a round. The cost model counts
+/// them (`crate::cost`), so the plan's admission stays right.
+pub const MAX_REPAIR_SEARCHES_PER_SENSOR: usize = 8;
+
 /// The sensors in rank order, and what each searches from.
 pub(super) struct Ranking<'f, 'a> {
     /// The sensors being planned.
@@ -96,16 +102,20 @@ impl Ranking<'_, '_> {
     /// close to another that can have fewer violations against every other
     /// path takes that path, the ranks below it plan again in order, and
     /// the change stays if fewer pairs are too close. Returns the rounds
-    /// run (at most [`MAX_REPAIRS`]).
+    /// run (at most [`MAX_REPAIRS`]) and the searches they made; they stop
+    /// early too once they have searched [`MAX_REPAIR_SEARCHES_PER_SENSOR`]
+    /// times per sensor.
     ///
     /// # Errors
     /// [`Cancelled`] once the fleet's token is cancelled.
-    pub fn repair(&self, plans: &mut Vec<SensorPlan>) -> Result<usize, Cancelled> {
+    pub fn repair(&self, plans: &mut Vec<SensorPlan>) -> Result<(usize, usize), Cancelled> {
         let d = self.fleet.min_separation;
         let n = self.order.len();
         let mut repairs = 0;
+        let budget = MAX_REPAIR_SEARCHES_PER_SENSOR * n;
+        let mut searches = 0;
         let mut total = separation::count(&path_slices(plans), d);
-        while total.pairs > 0 && repairs < MAX_REPAIRS {
+        while total.pairs > 0 && repairs < MAX_REPAIRS && searches < budget {
             repairs += 1;
             let mut improved = false;
             for rank in 0..n {
@@ -113,7 +123,11 @@ impl Ranking<'_, '_> {
                 if total.per_sensor[i] == 0 {
                     continue;
                 }
+                if searches >= budget {
+                    break;
+                }
                 let candidate = self.ranked(plans, rank, true);
+                searches += 1;
                 self.fleet.cancel.check()?;
                 if candidate.violations >= total.per_sensor[i] {
                     continue;
@@ -122,6 +136,7 @@ impl Ranking<'_, '_> {
                 trial[i] = candidate;
                 for below in rank + 1..n {
                     trial[self.order[below]] = self.ranked(&trial, below, false);
+                    searches += 1;
                     self.fleet.cancel.check()?;
                 }
                 let after = separation::count(&path_slices(&trial), d);
@@ -135,6 +150,6 @@ impl Ranking<'_, '_> {
                 break;
             }
         }
-        Ok(repairs)
+        Ok((repairs, searches))
     }
 }

@@ -4,7 +4,8 @@
 //! work.
 
 use super::reach::{
-    half, iterated_rounds, near_by_step, obstructed_share, rays_per_look, source_rays,
+    half, iterated_rounds, near_by_step, obstructed_share, rays_per_look, repair_passes,
+    source_rays,
 };
 use crate::coordination::{Coordination, first_search_budget};
 use crate::planner::{PlanInput, Planner};
@@ -81,6 +82,7 @@ pub fn first_terms(planner: &Planner, input: &PlanInput, estimator: f64) -> Firs
     let per_look = rays_per_look(s, input, &source_rays(s));
     let certificate = if input.certify { 1.0 } else { 0.0 };
     let searches = certificate
+        + repair_passes(s, input)
         + match input.coordination {
             Coordination::None => 1.0,
             Coordination::Priority => 2.0,

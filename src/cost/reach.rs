@@ -1,6 +1,7 @@
 //! What a plan request's sensors reach and see, read off the scenario and
 //! the request: the counts the plan models' terms are built from.
 
+use crate::coordination::MAX_REPAIR_SEARCHES_PER_SENSOR;
 use crate::estimator::SourceRays;
 use crate::planner::PlanInput;
 use crate::scenario::{Cell, FovSpec, Scenario};
@@ -122,6 +123,33 @@ pub(super) fn near_by_step(s: &Scenario, input: &PlanInput) -> Vec<u32> {
         }
     }
     near
+}
+
+/// Passes of searches (a pass: one per sensor) that a plan's separation
+/// repair may run ([`crate::coordination::MAX_REPAIR_SEARCHES_PER_SENSOR`]
+/// and the trial under way when they run out): none without a separation
+/// or when no two sensors can come within it of each other in the
+/// horizon, as then no pair is ever too close.
+pub(super) fn repair_passes(s: &Scenario, input: &PlanInput) -> f64 {
+    let d = input.min_separation as i64;
+    if d == 0 {
+        return 0.0;
+    }
+    let big_t = input.horizon as i64;
+    let starts = &input.starts;
+    let speeds = |i: usize| s.types[input.types[i]].speed;
+    let crowded = (0..starts.len()).any(|i| {
+        (i + 1..starts.len()).any(|q| {
+            let (a, b) = (starts[i], starts[q]);
+            let apart = i64::from((a.col - b.col).abs().max((a.row - b.row).abs()));
+            apart - (speeds(i) + speeds(q)) as i64 * big_t < d
+        })
+    });
+    if crowded {
+        (MAX_REPAIR_SEARCHES_PER_SENSOR + 1) as f64
+    } else {
+        0.0
+    }
 }
 
 /// Best-response rounds an `iterated` plan is expected to run, from the

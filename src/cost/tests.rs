@@ -269,3 +269,26 @@ fn the_issues_large_work_is_refused_or_a_job_and_the_reference_is_not() {
     assert!(precompute_ms(&big) > 1000.0);
     assert!(precompute_ms(&builtins()[0]) < 100.0);
 }
+
+/// The separation's repair is counted where it can run: sensors that may
+/// come within the separation of each other in the horizon pay for its
+/// searches (`MAX_REPAIR_SEARCHES_PER_SENSOR` passes and one more), a
+/// fleet spread wider than the separation and its reach does not.
+#[test]
+fn the_separation_repair_is_counted_where_pairs_can_meet() {
+    let p = Planner::new(builtins().remove(0));
+    let cost = |n: usize, d: usize| {
+        let mut req = request(&p.scenario, n, 3, 30, 16);
+        req.min_separation = Some(d.into());
+        plan_cost(&p, req, Priority)
+    };
+    // 100 sensors on a 300-wide zone of 10-wide cells: 3 cells apart.
+    assert!(
+        cost(100, 2) > 1.5 * cost(100, 0),
+        "{} vs {}",
+        cost(100, 2),
+        cost(100, 0)
+    );
+    // 4 sensors: 15 cells apart, more than 2 + 2·3 steps of reach.
+    assert_eq!(cost(4, 2), cost(4, 0));
+}

@@ -563,7 +563,56 @@ impl Chosen<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::Id;
+    use super::*;
+    use crate::coordination::MAX_REPAIR_SEARCHES_PER_SENSOR;
+    use crate::scenario::paper_spec;
+
+    /// A crowded fleet (64 sensors on neighbouring cells, 4 cells apart
+    /// asked) makes the separation's repair search about n² times a round;
+    /// its searches stop at their budget, which the cost model counts.
+    #[test]
+    fn the_separation_repair_searches_within_its_budget() {
+        let planner = Planner::new(Scenario::new(paper_spec(10.0)).expect("valid"));
+        let sensors: Vec<SensorIn> = (0..64)
+            .map(|i| SensorIn {
+                id: Id::Number((i as u64).into()),
+                x: 5.0 + 10.0 * f64::from(i % 8),
+                y: 5.0 + 10.0 * f64::from(i / 8),
+                sensor_type: None,
+            })
+            .collect();
+        let req = PlanRequest {
+            sensors,
+            horizon: Some(3.into()),
+            min_separation: Some(4.into()),
+            certify: Some(false),
+            ..Default::default()
+        };
+        let input = PlanInput::new(&planner.scenario, &req).expect("valid");
+        let cancel = CancelToken::new();
+        let est = planner
+            .estimator(&input, &cancel, None)
+            .expect("not cancelled");
+        let result = est
+            .with_fleet(&planner.scenario, &input, &cancel, |fleet| {
+                coordinate(
+                    fleet,
+                    input.coordination,
+                    input.joint,
+                    false,
+                    Instant::now(),
+                )
+            })
+            .expect("not cancelled");
+        let n = input.starts.len();
+        assert!(result.repairs > 0 && result.violations.pairs > 0);
+        // A trial under way finishes: at most one more search per sensor.
+        assert!(
+            result.repair_searches <= (MAX_REPAIR_SEARCHES_PER_SENSOR + 1) * n,
+            "{} searches",
+            result.repair_searches
+        );
+    }
 
     #[test]
     fn ids_are_strings_or_numbers_echoed_as_given() {
