@@ -210,9 +210,12 @@ pub struct PlanRequest {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(minimum = 0.0, maximum = 1.0)]
     pub gap_target: Option<f64>,
-    /// With `coordination: joint`: the most time the plan may take,
-    /// milliseconds (1..=1000, 20 by default), counted from its start and
-    /// within the server's time limit. Other coordinations ignore it.
+    /// With `coordination: joint`: the time after which its rounds past
+    /// `iterated` stop, milliseconds (1..=1000, 20 by default), counted
+    /// from the plan's start and within the server's time limit. The
+    /// `iterated` plan they start from is always finished, so a plan whose
+    /// `iterated` pass takes longer ends with `"stopped": "budget"` and 0
+    /// rounds. Other coordinations ignore it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schema(value_type = Option<u32>, minimum = 1)]
     pub budget_ms: Option<Integer>,

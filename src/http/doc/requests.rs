@@ -62,8 +62,10 @@ macro_rules! plan_request_with {
             /// stops, in `[0, 1]`; 0.001 by default.
             #[schema(minimum = 0.0, maximum = 1.0)]
             pub gap_target: Option<f64>,
-            /// With `coordination: joint`: the most time the plan may
-            /// take, milliseconds (1..=1000, 20 by default).
+            /// With `coordination: joint`: the time after which its
+            /// rounds past `iterated` stop, milliseconds (1..=1000, 20 by
+            /// default), counted from the plan's start; the `iterated`
+            /// plan they start from is always finished.
             #[schema(value_type = Option<u32>, minimum = 1)]
             pub budget_ms: Option<Integer>,
             /// Certify the plan (`bound`, exact plans; true by default):

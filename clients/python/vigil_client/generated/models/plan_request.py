@@ -28,9 +28,12 @@ class PlanRequest:
 
     Attributes:
         sensors (list[SensorIn]): Sensors now.
-        budget_ms (int | None | Unset): With `coordination: joint`: the most time the plan may take,
-            milliseconds (1..=1000, 20 by default), counted from its start and
-            within the server's time limit. Other coordinations ignore it.
+        budget_ms (int | None | Unset): With `coordination: joint`: the time after which its rounds past
+            `iterated` stop, milliseconds (1..=1000, 20 by default), counted
+            from the plan's start and within the server's time limit. The
+            `iterated` plan they start from is always finished, so a plan whose
+            `iterated` pass takes longer ends with `"stopped": "budget"` and 0
+            rounds. Other coordinations ignore it.
         certify (bool | None | Unset): Certify the plan: with the `exact` estimator the response carries
             `bound`, an upper bound on the best joint plan (true by default).
             `false` skips the certificate's work and leaves `bound` out; the

@@ -29,8 +29,10 @@ class PlanRequestById:
     Attributes:
         scenario_id (str): Id of a registered scenario, or of one sent inline before. Example: paper-v10.
         sensors (list[SensorIn]): Sensors now.
-        budget_ms (int | None | Unset): With `coordination: joint`: the most time the plan may
-            take, milliseconds (1..=1000, 20 by default).
+        budget_ms (int | None | Unset): With `coordination: joint`: the time after which its
+            rounds past `iterated` stop, milliseconds (1..=1000, 20 by
+            default), counted from the plan's start; the `iterated`
+            plan they start from is always finished.
         certify (bool | None | Unset): Certify the plan (`bound`, exact plans; true by default):
             `false` skips the certificate's work and leaves `bound`
             out; refused with `coordination: joint`.
