@@ -620,3 +620,47 @@ fn co_located_uncertain_sensors_add_exposure() {
         assert!((a - b).abs() < 1e-9 * b, "source {j}: pair {a}, one {b}");
     }
 }
+
+/// Few rays suffice where the exposure is smooth in the takeoff angle: a
+/// narrow cone (10°, 7 rays) and a far source (the zone 6° wide from it, 5
+/// rays) into a square zone have the exposure of a 4096-rays-per-π grid
+/// to 0.5%. (A cone along a long, thin zone, whose rays' lengths vary as
+/// 1/angle, does not: see docs/learning.md.)
+#[test]
+fn narrow_cones_and_far_sources_into_a_square_zone() {
+    let spec = |source: Value| {
+        json!({
+            "zone": {"width": 200.0, "height": 200.0},
+            "cell_size": 10.0,
+            "fov": {"shape": "square", "half_width": 25.0},
+            "target_speed": 5.0,
+            "sensor_types": {
+                "drone": {"fov": {"shape": "square", "half_width": 20.0}, "speed": 2,
+                          "p_detect": 0.6, "elevated": true}
+            },
+            "sources": [source]
+        })
+    };
+    for (name, source) in [
+        (
+            "narrow cone",
+            json!({"x": -1.0, "y": 100.0, "rate": 0.2, "direction": 10.0, "spread": 10.0}),
+        ),
+        ("far source", json!({"x": -2000.0, "y": 150.0, "rate": 0.2})),
+    ] {
+        let s = scenario(spec(source));
+        let planner = Arc::new(Planner::new(s.clone()));
+        let looks = looks_of(&s, &driven(&planner, &s, 60, 5));
+        let fine = WindowLooks::with_rays_per_pi(&s, &looks, 4096).exposure(0)[0];
+        let used = WindowLooks::new(&s, &looks).exposure(0)[0];
+        let rel = used / fine - 1.0;
+        eprintln!(
+            "{name}: {} rays per π against 4096: {rel:+.2e} ({used} against {fine})",
+            s.rays_per_pi()
+        );
+        assert!(
+            fine > 1.0 && rel.abs() < 5e-3,
+            "{name}: {used} against {fine}"
+        );
+    }
+}
