@@ -46,8 +46,9 @@ pub struct SensorPathIn {
 }
 
 /// Body of `POST /v1/scenarios/{id}/evaluate`: a plan request (its
-/// `coordination`, `explain`, `gap_target` and `budget_ms` are accepted and
-/// play no part) plus the paths to score.
+/// `coordination`, `explain`, `gap_target`, `budget_ms` and `certify` are
+/// checked as a plan checks them and play no part) plus the paths to
+/// score.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EvaluateRequest {
     /// The sensors, targets, history and options, as in a plan request.

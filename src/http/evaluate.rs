@@ -51,8 +51,9 @@ async fn evaluate_admitted(
         distinct targets detected over steps 1..T (the total a plan reports as \
         `expected_detections`, and per step), each sensor's marginal (what the total loses \
         without its path) and the breaches of the minimum separation, with the requested \
-        estimator. The body is a plan request (its `coordination`, `explain`, `gap_target` and \
-        `budget_ms` play no part) plus `paths`. A plan's own paths score its \
+        estimator. The body is a plan request (its `coordination`, `explain`, `gap_target`, \
+        `budget_ms` and `certify` are checked as a plan checks them, so a plan's body scores as \
+        sent, and play no part) plus `paths`. A plan's own paths score its \
         `expected_detections`. With the `paper` estimator, whose total depends on the order, \
         the paths count in the order given, the first as the highest priority.", plan_rules!(), path_rules!()),
     params(("id" = String, Path, description = doc::SCENARIO_ID, example = "paper-v10")),

@@ -245,7 +245,11 @@ pub struct CellOut {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
 pub struct Explain {
     /// `values[t−1][dr+m·T][dc+m·T]` (m the sensor's speed); null where
-    /// unreachable by step t, blocked or off the lattice.
+    /// unreachable by step t, blocked or off the lattice. With
+    /// `first_detections` each is the first detections of a look there
+    /// alone (against the history and the looks the sensor planned
+    /// against): a path's stops can hold the same targets, so its value is
+    /// at most the sum of its cells' values, not the sum.
     pub values: Vec<Vec<Vec<Option<f64>>>>,
 }
 

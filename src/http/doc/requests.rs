@@ -105,7 +105,8 @@ pub enum InlinePlanRequest {
 plan_request_with!(
     /// Body of `POST /v1/scenarios/{id}/evaluate`: a plan request's fields
     /// (its `coordination`, `explain`, `gap_target`, `budget_ms` and
-    /// `certify` play no part) and the paths to score.
+    /// `certify` are checked as a plan checks them, so a plan's body
+    /// scores as sent, and play no part) and the paths to score.
     EvaluateBody,
     /// One path per sensor.
     #[schema(min_items = 1)]

@@ -27,7 +27,8 @@ T = TypeVar("T", bound="EvaluateBody")
 class EvaluateBody:
     """Body of `POST /v1/scenarios/{id}/evaluate`: a plan request's fields
     (its `coordination`, `explain`, `gap_target`, `budget_ms` and
-    `certify` play no part) and the paths to score.
+    `certify` are checked as a plan checks them, so a plan's body
+    scores as sent, and play no part) and the paths to score.
 
         Attributes:
             paths (list[SensorPathIn]): One path per sensor.

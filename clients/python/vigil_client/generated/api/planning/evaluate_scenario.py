@@ -106,15 +106,16 @@ def sync_detailed(
      Scores one path per sensor, whoever planned it: the expected number of distinct targets detected
     over steps 1..T (the total a plan reports as `expected_detections`, and per step), each sensor's
     marginal (what the total loses without its path) and the breaches of the minimum separation, with
-    the requested estimator. The body is a plan request (its `coordination`, `explain`, `gap_target` and
-    `budget_ms` play no part) plus `paths`. A plan's own paths score its `expected_detections`. With the
-    `paper` estimator, whose total depends on the order, the paths count in the order given, the first
-    as the highest priority. Rules no schema can state (each a 422 whose `detail` names the field):
-    every sensor and history position lies in the scenario's zone, and sensor ids are unique; no ground
-    sensor (a type not `elevated`), now or in the history, stands on a cell whose centre lies in a
-    building; and with obstacles the estimator is `exact`. The paths' rules (each a 422 whose `detail`
-    names the field): one path per sensor, each naming a sensor of `sensors` once, of exactly T cells
-    (the horizon's steps 1..T), every cell on the lattice and outside the no-go zones (and, for a ground
+    the requested estimator. The body is a plan request (its `coordination`, `explain`, `gap_target`,
+    `budget_ms` and `certify` are checked as a plan checks them, so a plan's body scores as sent, and
+    play no part) plus `paths`. A plan's own paths score its `expected_detections`. With the `paper`
+    estimator, whose total depends on the order, the paths count in the order given, the first as the
+    highest priority. Rules no schema can state (each a 422 whose `detail` names the field): every
+    sensor and history position lies in the scenario's zone, and sensor ids are unique; no ground sensor
+    (a type not `elevated`), now or in the history, stands on a cell whose centre lies in a building;
+    and with obstacles the estimator is `exact`. The paths' rules (each a 422 whose `detail` names the
+    field): one path per sensor, each naming a sensor of `sensors` once, of exactly T cells (the
+    horizon's steps 1..T), every cell on the lattice and outside the no-go zones (and, for a ground
     sensor, outside the buildings), each step a move of at most the sensor type's speed (king moves)
     that free cells allow, from the sensor's own cell.
 
@@ -122,7 +123,8 @@ def sync_detailed(
         id (str):
         body (EvaluateBody): Body of `POST /v1/scenarios/{id}/evaluate`: a plan request's fields
             (its `coordination`, `explain`, `gap_target`, `budget_ms` and
-            `certify` play no part) and the paths to score.
+            `certify` are checked as a plan checks them, so a plan's body
+            scores as sent, and play no part) and the paths to score.
 
     Raises:
         errors.UnexpectedStatus: If the server returns an undocumented status code and Client.raise_on_unexpected_status is True.
@@ -155,15 +157,16 @@ def sync(
      Scores one path per sensor, whoever planned it: the expected number of distinct targets detected
     over steps 1..T (the total a plan reports as `expected_detections`, and per step), each sensor's
     marginal (what the total loses without its path) and the breaches of the minimum separation, with
-    the requested estimator. The body is a plan request (its `coordination`, `explain`, `gap_target` and
-    `budget_ms` play no part) plus `paths`. A plan's own paths score its `expected_detections`. With the
-    `paper` estimator, whose total depends on the order, the paths count in the order given, the first
-    as the highest priority. Rules no schema can state (each a 422 whose `detail` names the field):
-    every sensor and history position lies in the scenario's zone, and sensor ids are unique; no ground
-    sensor (a type not `elevated`), now or in the history, stands on a cell whose centre lies in a
-    building; and with obstacles the estimator is `exact`. The paths' rules (each a 422 whose `detail`
-    names the field): one path per sensor, each naming a sensor of `sensors` once, of exactly T cells
-    (the horizon's steps 1..T), every cell on the lattice and outside the no-go zones (and, for a ground
+    the requested estimator. The body is a plan request (its `coordination`, `explain`, `gap_target`,
+    `budget_ms` and `certify` are checked as a plan checks them, so a plan's body scores as sent, and
+    play no part) plus `paths`. A plan's own paths score its `expected_detections`. With the `paper`
+    estimator, whose total depends on the order, the paths count in the order given, the first as the
+    highest priority. Rules no schema can state (each a 422 whose `detail` names the field): every
+    sensor and history position lies in the scenario's zone, and sensor ids are unique; no ground sensor
+    (a type not `elevated`), now or in the history, stands on a cell whose centre lies in a building;
+    and with obstacles the estimator is `exact`. The paths' rules (each a 422 whose `detail` names the
+    field): one path per sensor, each naming a sensor of `sensors` once, of exactly T cells (the
+    horizon's steps 1..T), every cell on the lattice and outside the no-go zones (and, for a ground
     sensor, outside the buildings), each step a move of at most the sensor type's speed (king moves)
     that free cells allow, from the sensor's own cell.
 
@@ -171,7 +174,8 @@ def sync(
         id (str):
         body (EvaluateBody): Body of `POST /v1/scenarios/{id}/evaluate`: a plan request's fields
             (its `coordination`, `explain`, `gap_target`, `budget_ms` and
-            `certify` play no part) and the paths to score.
+            `certify` are checked as a plan checks them, so a plan's body
+            scores as sent, and play no part) and the paths to score.
 
     Raises:
         errors.UnexpectedStatus: If the server returns an undocumented status code and Client.raise_on_unexpected_status is True.
@@ -199,15 +203,16 @@ async def asyncio_detailed(
      Scores one path per sensor, whoever planned it: the expected number of distinct targets detected
     over steps 1..T (the total a plan reports as `expected_detections`, and per step), each sensor's
     marginal (what the total loses without its path) and the breaches of the minimum separation, with
-    the requested estimator. The body is a plan request (its `coordination`, `explain`, `gap_target` and
-    `budget_ms` play no part) plus `paths`. A plan's own paths score its `expected_detections`. With the
-    `paper` estimator, whose total depends on the order, the paths count in the order given, the first
-    as the highest priority. Rules no schema can state (each a 422 whose `detail` names the field):
-    every sensor and history position lies in the scenario's zone, and sensor ids are unique; no ground
-    sensor (a type not `elevated`), now or in the history, stands on a cell whose centre lies in a
-    building; and with obstacles the estimator is `exact`. The paths' rules (each a 422 whose `detail`
-    names the field): one path per sensor, each naming a sensor of `sensors` once, of exactly T cells
-    (the horizon's steps 1..T), every cell on the lattice and outside the no-go zones (and, for a ground
+    the requested estimator. The body is a plan request (its `coordination`, `explain`, `gap_target`,
+    `budget_ms` and `certify` are checked as a plan checks them, so a plan's body scores as sent, and
+    play no part) plus `paths`. A plan's own paths score its `expected_detections`. With the `paper`
+    estimator, whose total depends on the order, the paths count in the order given, the first as the
+    highest priority. Rules no schema can state (each a 422 whose `detail` names the field): every
+    sensor and history position lies in the scenario's zone, and sensor ids are unique; no ground sensor
+    (a type not `elevated`), now or in the history, stands on a cell whose centre lies in a building;
+    and with obstacles the estimator is `exact`. The paths' rules (each a 422 whose `detail` names the
+    field): one path per sensor, each naming a sensor of `sensors` once, of exactly T cells (the
+    horizon's steps 1..T), every cell on the lattice and outside the no-go zones (and, for a ground
     sensor, outside the buildings), each step a move of at most the sensor type's speed (king moves)
     that free cells allow, from the sensor's own cell.
 
@@ -215,7 +220,8 @@ async def asyncio_detailed(
         id (str):
         body (EvaluateBody): Body of `POST /v1/scenarios/{id}/evaluate`: a plan request's fields
             (its `coordination`, `explain`, `gap_target`, `budget_ms` and
-            `certify` play no part) and the paths to score.
+            `certify` are checked as a plan checks them, so a plan's body
+            scores as sent, and play no part) and the paths to score.
 
     Raises:
         errors.UnexpectedStatus: If the server returns an undocumented status code and Client.raise_on_unexpected_status is True.
@@ -246,15 +252,16 @@ async def asyncio(
      Scores one path per sensor, whoever planned it: the expected number of distinct targets detected
     over steps 1..T (the total a plan reports as `expected_detections`, and per step), each sensor's
     marginal (what the total loses without its path) and the breaches of the minimum separation, with
-    the requested estimator. The body is a plan request (its `coordination`, `explain`, `gap_target` and
-    `budget_ms` play no part) plus `paths`. A plan's own paths score its `expected_detections`. With the
-    `paper` estimator, whose total depends on the order, the paths count in the order given, the first
-    as the highest priority. Rules no schema can state (each a 422 whose `detail` names the field):
-    every sensor and history position lies in the scenario's zone, and sensor ids are unique; no ground
-    sensor (a type not `elevated`), now or in the history, stands on a cell whose centre lies in a
-    building; and with obstacles the estimator is `exact`. The paths' rules (each a 422 whose `detail`
-    names the field): one path per sensor, each naming a sensor of `sensors` once, of exactly T cells
-    (the horizon's steps 1..T), every cell on the lattice and outside the no-go zones (and, for a ground
+    the requested estimator. The body is a plan request (its `coordination`, `explain`, `gap_target`,
+    `budget_ms` and `certify` are checked as a plan checks them, so a plan's body scores as sent, and
+    play no part) plus `paths`. A plan's own paths score its `expected_detections`. With the `paper`
+    estimator, whose total depends on the order, the paths count in the order given, the first as the
+    highest priority. Rules no schema can state (each a 422 whose `detail` names the field): every
+    sensor and history position lies in the scenario's zone, and sensor ids are unique; no ground sensor
+    (a type not `elevated`), now or in the history, stands on a cell whose centre lies in a building;
+    and with obstacles the estimator is `exact`. The paths' rules (each a 422 whose `detail` names the
+    field): one path per sensor, each naming a sensor of `sensors` once, of exactly T cells (the
+    horizon's steps 1..T), every cell on the lattice and outside the no-go zones (and, for a ground
     sensor, outside the buildings), each step a move of at most the sensor type's speed (king moves)
     that free cells allow, from the sensor's own cell.
 
@@ -262,7 +269,8 @@ async def asyncio(
         id (str):
         body (EvaluateBody): Body of `POST /v1/scenarios/{id}/evaluate`: a plan request's fields
             (its `coordination`, `explain`, `gap_target`, `budget_ms` and
-            `certify` play no part) and the paths to score.
+            `certify` are checked as a plan checks them, so a plan's body
+            scores as sent, and play no part) and the paths to score.
 
     Raises:
         errors.UnexpectedStatus: If the server returns an undocumented status code and Client.raise_on_unexpected_status is True.
