@@ -150,9 +150,18 @@ impl EvaluateInput {
         for (k, given) in req.paths.iter().enumerate() {
             let field = format!("paths[{k}]");
             let Some(&i) = index.get(&given.sensor.key()) else {
+                // `7` and `"7"` are two ids: name the near miss.
+                let text = given.sensor.to_string();
+                let near = plan
+                    .ids
+                    .iter()
+                    .find(|id| id.to_string().trim_matches('"') == text.trim_matches('"'));
+                let hint = near.map_or(String::new(), |id| {
+                    format!(" (it has {id}: a string id and a number id differ)")
+                });
                 return Err(ValidationError::new(
                     format!("{field}.sensor"),
-                    format!("no sensor {} in `sensors`", given.sensor),
+                    format!("no sensor {} in `sensors`{hint}", given.sensor),
                 ));
             };
             if paths[i].is_some() {

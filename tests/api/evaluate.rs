@@ -127,6 +127,14 @@ async fn illegal_paths_are_422_naming_the_field() {
             "no sensor \"z\"",
         ),
         (
+            Box::new(|ev| {
+                ev["sensors"][1]["id"] = json!(7);
+                ev["paths"][1]["sensor"] = json!("7");
+            }),
+            "paths[1].sensor",
+            "no sensor \"7\" in `sensors` (it has 7: a string id and a number id differ)",
+        ),
+        (
             Box::new(|ev| ev["paths"][1]["sensor"] = json!("a")),
             "paths[1].sensor",
             "a second path",
