@@ -614,6 +614,36 @@ mod tests {
         );
     }
 
+    /// Ids are equal as JSON values: a number however written, never a
+    /// number and a string; `key` agrees with equality.
+    #[test]
+    fn ids_are_equal_as_json_values() {
+        let id = |text: &str| -> Id { serde_json::from_str(text).expect(text) };
+        let same = [
+            ("7", "7.0"),
+            ("7", "7e0"),
+            ("-3", "-3.0"),
+            ("0", "-0.0"),
+            ("1.5", "15e-1"),
+            ("18446744073709551615", "18446744073709551615"),
+            (r#""a""#, r#""a""#),
+        ];
+        for (a, b) in same {
+            assert_eq!(id(a), id(b), "{a} {b}");
+            assert_eq!(id(a).key(), id(b).key(), "{a} {b}");
+        }
+        let differ = [
+            ("7", r#""7""#),
+            ("7", "7.5"),
+            ("9007199254740993", "9007199254740992"),
+            (r#""7.0""#, r#""7""#),
+        ];
+        for (a, b) in differ {
+            assert_ne!(id(a), id(b), "{a} {b}");
+            assert_ne!(id(a).key(), id(b).key(), "{a} {b}");
+        }
+    }
+
     #[test]
     fn ids_are_strings_or_numbers_echoed_as_given() {
         for text in [

@@ -40,8 +40,10 @@ crate::by_name::by_name!(Observed {
     "zone" => Observed::Zone,
 });
 
-/// A sensor or target id: a string or a number, echoed back as given.
-#[derive(Debug, Clone, PartialEq, Serialize, ToSchema)]
+/// A sensor or target id: a string or a number, echoed back as given. Two
+/// ids are the same when they are the same JSON value: `"7"` and `7`
+/// differ, `7` and `7.0` do not (JSON has one number type).
+#[derive(Debug, Clone, Serialize, ToSchema)]
 #[serde(untagged)]
 #[schema(examples("a", 7))]
 pub enum Id {
@@ -94,12 +96,52 @@ impl std::fmt::Display for Id {
     }
 }
 
+impl PartialEq for Id {
+    fn eq(&self, other: &Self) -> bool {
+        match (self, other) {
+            (Id::Text(a), Id::Text(b)) => a == b,
+            (Id::Number(a), Id::Number(b)) => Numeric::of(a) == Numeric::of(b),
+            _ => false,
+        }
+    }
+}
+
+/// A numeric id's value: a whole number exactly (`7`, `7.0` and `7e0`
+/// alike), else the float.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Numeric {
+    Whole(i128),
+    Float(f64),
+}
+
+impl Numeric {
+    fn of(n: &serde_json::Number) -> Self {
+        if let Some(i) = n.as_i64() {
+            return Numeric::Whole(i128::from(i));
+        }
+        if let Some(u) = n.as_u64() {
+            return Numeric::Whole(i128::from(u));
+        }
+        // Finite (an id is): a float's whole values fit an i128 up to 1.7e38.
+        let f = n.as_f64().unwrap_or(f64::NAN);
+        if f.fract() == 0.0 && f.abs() < 1e38 {
+            Numeric::Whole(f as i128)
+        } else {
+            Numeric::Float(f)
+        }
+    }
+}
+
 impl Id {
-    /// A key that tells ids apart: `"7"` and `7` are two ids.
+    /// A key that tells ids apart as [`Id`]'s equality does: `"7"` and `7`
+    /// are two ids, `7` and `7.0` one.
     pub(crate) fn key(&self) -> String {
         match self {
             Id::Text(s) => format!("s:{s}"),
-            Id::Number(n) => format!("n:{n}"),
+            Id::Number(n) => match Numeric::of(n) {
+                Numeric::Whole(i) => format!("n:{i}"),
+                Numeric::Float(f) => format!("n:{f}"),
+            },
         }
     }
 }

@@ -17,7 +17,9 @@ class DetectionIn:
     """A target detected at a step.
 
     Attributes:
-        id (float | str): A sensor or target id: a string or a number, echoed back as given.
+        id (float | str): A sensor or target id: a string or a number, echoed back as given. Two
+            ids are the same when they are the same JSON value: `"7"` and `7`
+            differ, `7` and `7.0` do not (JSON has one number type).
         vx (float): East displacement per step.
         vy (float): North displacement per step.
         x (float): East coordinate.

@@ -27,7 +27,9 @@ class PlanOut:
             first detections its path adds to those it planned against).
         path (list[CellOut]): Cells at steps 1..=T.
         priority (int): Rank, 1 = highest.
-        sensor (float | str): A sensor or target id: a string or a number, echoed back as given.
+        sensor (float | str): A sensor or target id: a string or a number, echoed back as given. Two
+            ids are the same when they are the same JSON value: `"7"` and `7`
+            differ, `7` and `7.0` do not (JSON has one number type).
         separation_violations (int): The (step, other sensor) pairs at which its path is closer to
             another sensor's than `min_separation` allows.
         start (CellOut): A lattice cell and its centre.

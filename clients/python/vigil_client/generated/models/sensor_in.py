@@ -18,7 +18,9 @@ class SensorIn:
     """A sensor's current position.
 
     Attributes:
-        id (float | str): A sensor or target id: a string or a number, echoed back as given.
+        id (float | str): A sensor or target id: a string or a number, echoed back as given. Two
+            ids are the same when they are the same JSON value: `"7"` and `7`
+            differ, `7` and `7.0` do not (JSON has one number type).
         x (float): East coordinate.
         y (float): North coordinate.
         type_ (None | str | Unset): Its sensor type (a name of the scenario's `sensor_types`);

@@ -21,7 +21,9 @@ class SensorPathIn:
 
     Attributes:
         path (list[CellIn]): Its cells at steps 1..=T.
-        sensor (float | str): A sensor or target id: a string or a number, echoed back as given.
+        sensor (float | str): A sensor or target id: a string or a number, echoed back as given. Two
+            ids are the same when they are the same JSON value: `"7"` and `7`
+            differ, `7` and `7.0` do not (JSON has one number type).
     """
 
     path: list[CellIn]

@@ -19,7 +19,9 @@ class SensorScore:
 
     Attributes:
         marginal (float): What the total loses without this sensor's path.
-        sensor (float | str): A sensor or target id: a string or a number, echoed back as given.
+        sensor (float | str): A sensor or target id: a string or a number, echoed back as given. Two
+            ids are the same when they are the same JSON value: `"7"` and `7`
+            differ, `7` and `7.0` do not (JSON has one number type).
         separation_violations (int): The (step, other sensor) pairs at which its path is closer to
             another sensor's than `min_separation` allows.
     """

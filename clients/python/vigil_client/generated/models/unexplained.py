@@ -22,7 +22,9 @@ class Unexplained:
 
     Attributes:
         entry (PointOut): A point.
-        id (float | str): A sensor or target id: a string or a number, echoed back as given.
+        id (float | str): A sensor or target id: a string or a number, echoed back as given. Two
+            ids are the same when they are the same JSON value: `"7"` and `7`
+            differ, `7` and `7.0` do not (JSON has one number type).
     """
 
     entry: PointOut
