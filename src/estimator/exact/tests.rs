@@ -660,3 +660,82 @@ fn detected_upto_is_the_detected_length_up_to_a_point() {
         }
     }
 }
+
+/// The known targets a windowed fill reads for each cell are those its
+/// view's containment test holds, counted and summed in the targets'
+/// order: the same to the bit as testing every cell against every target.
+/// Targets on the views' edges, at the zone's edges and partly seen
+/// included, for a square view and for one clipped by the zone.
+#[test]
+fn known_targets_in_views_are_those_each_view_holds() {
+    use crate::geometry::Point;
+    let s = Scenario::new(site_fleet_spec()).expect("valid");
+    for ty in 0..s.types.len() {
+        let FovSpec::Square { half_width } = s.types[ty].fov else {
+            continue;
+        };
+        for start in [
+            Cell { col: 3, row: 2 },
+            Cell {
+                col: s.cols / 2,
+                row: s.rows / 2,
+            },
+        ] {
+            let k = 4;
+            let mut clear = Vec::new();
+            let mut partial = Vec::new();
+            for i in 0..400u32 {
+                let c = s.centre(start.offset((i % 13) as i32 - 6, (i / 13 % 11) as i32 - 5));
+                // On an edge, just inside or outside it, or in between.
+                let dx = [
+                    half_width,
+                    -half_width,
+                    half_width + 1e-9,
+                    0.37 * half_width,
+                ][i as usize % 4];
+                let dy = [-half_width, 0.0, half_width - 1e-9, half_width][i as usize / 4 % 4];
+                let p = Point::new(c.x + dx, c.y + dy);
+                if !s.in_zone(p) {
+                    continue;
+                }
+                if i % 3 == 0 {
+                    partial.push((p, 0.1 + f64::from(i % 7) / 9.0));
+                } else {
+                    clear.push(p);
+                }
+            }
+            // The zone's corner and edges.
+            clear.extend([
+                Point::new(0.0, 0.0),
+                Point::new(s.width, 0.0),
+                Point::new(0.0, 5.0),
+            ]);
+            let known = super::KnownInViews::new(&s, ty, start, k, &clear, &partial);
+            let mut fractional = 0;
+            for dr in -k..=k {
+                for dc in -k..=k {
+                    let Some(cell) = s.lattice_cell(start, dc, dr) else {
+                        continue;
+                    };
+                    let fk = s.fov_region_of(ty, cell);
+                    let mut want = clear.iter().filter(|&&p| fk.contains(p)).count() as f64;
+                    want += partial
+                        .iter()
+                        .filter(|(p, _)| fk.contains(*p))
+                        .map(|&(_, miss)| miss)
+                        .sum::<f64>();
+                    assert_eq!(
+                        known.at(dc, dr).to_bits(),
+                        want.to_bits(),
+                        "type {ty} start {start:?} offset ({dc}, {dr})"
+                    );
+                    fractional += usize::from(want.fract() != 0.0);
+                }
+            }
+            assert!(
+                fractional > 20,
+                "type {ty}: {fractional} cells with partly seen targets"
+            );
+        }
+    }
+}
