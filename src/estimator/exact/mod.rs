@@ -672,18 +672,30 @@ impl Estimator for ExactEstimator<'_> {
                 miss => partial.push((p, miss)),
             }
         }
-        let known = KnownInViews::new(
-            s,
-            self.types[sensor],
-            start,
-            (ty.speed * t) as i32,
-            &clear,
-            &partial,
-        );
+        let k = (ty.speed * t) as i32;
+        let cells = ((2 * k + 1) * (2 * k + 1)) as usize;
+        // Few targets: testing each cell against each is cheaper than the
+        // blocks' buffers, and gives the same values.
+        let blocks = ((clear.len() + partial.len()) * cells > BLOCKS_FROM)
+            .then(|| KnownInViews::new(s, self.types[sensor], start, k, &clear, &partial));
         out.fill_step(t, |dc, dr| {
-            let k = s.lattice_cell(start, dc, dr)?;
-            let unseen = sums.sum(grid.span(ty.fov_slot, k));
-            let known = known.at(dc, dr);
+            let cell = s.lattice_cell(start, dc, dr)?;
+            let unseen = sums.sum(grid.span(ty.fov_slot, cell));
+            let known = match &blocks {
+                Some(blocks) => blocks.at(dc, dr),
+                None => {
+                    let fk = s.fov_region_of(self.types[sensor], cell);
+                    let mut known = clear.iter().filter(|&&p| fk.contains(p)).count() as f64;
+                    if !partial.is_empty() {
+                        known += partial
+                            .iter()
+                            .filter(|(p, _)| fk.contains(*p))
+                            .map(|&(_, miss)| miss)
+                            .sum::<f64>();
+                    }
+                    known
+                }
+            };
             Some(ty.p_detect * (known + unseen))
         });
     }
@@ -737,6 +749,11 @@ impl Estimator for ExactEstimator<'_> {
         true
     }
 }
+
+/// Cells × known targets past which a windowed fill counts the targets
+/// per view block ([`KnownInViews`]) rather than testing every cell
+/// against every target (the two give the same values).
+const BLOCKS_FROM: usize = 2048;
 
 /// The known targets in the square field of view of a sensor's type at
 /// every cell within `k` cells of its start: those no excluded look holds
