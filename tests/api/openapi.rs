@@ -371,6 +371,18 @@ async fn every_documented_operation_is_served_as_documented() {
     }
 }
 
+/// The names of an object schema's properties, sorted.
+fn property_names(schema: &Value) -> Vec<String> {
+    let mut names: Vec<String> = schema["properties"]
+        .as_object()
+        .unwrap()
+        .keys()
+        .cloned()
+        .collect();
+    names.sort();
+    names
+}
+
 /// `POST /v1/plan`'s doc-only body schema is one of two objects, each
 /// `PlanRequest`'s fields and one more, required: `scenario_id` or
 /// `scenario`. A body with both or neither matches neither.
@@ -378,16 +390,7 @@ async fn every_documented_operation_is_served_as_documented() {
 fn inline_plan_request_extends_plan_request() {
     let doc = document();
     let schemas = &doc["components"]["schemas"];
-    let fields = |name: &str| -> Vec<String> {
-        let mut f: Vec<String> = schemas[name]["properties"]
-            .as_object()
-            .unwrap()
-            .keys()
-            .cloned()
-            .collect();
-        f.sort();
-        f
-    };
+    let fields = |name: &str| property_names(&schemas[name]);
     let refs: Vec<&str> = schemas["InlinePlanRequest"]["oneOf"]
         .as_array()
         .unwrap()
@@ -442,16 +445,7 @@ fn inline_plan_request_extends_plan_request() {
 fn session_bodies_take_every_setting() {
     let doc = document();
     let schemas = &doc["components"]["schemas"];
-    let fields = |name: &str| -> Vec<String> {
-        let mut f: Vec<String> = schemas[name]["properties"]
-            .as_object()
-            .unwrap()
-            .keys()
-            .cloned()
-            .collect();
-        f.sort();
-        f
-    };
+    let fields = |name: &str| property_names(&schemas[name]);
     // Every field set: a field added to the settings fails to compile here.
     let all = vigil::session::SessionSettings {
         horizon: Some(3.into()),
