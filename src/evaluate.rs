@@ -326,10 +326,7 @@ impl<'p> Evaluator<'p> {
                         return by_step.iter().sum::<f64>()
                             - fleet.by_step(paths, &others).iter().sum::<f64>();
                     }
-                    let rank = order.iter().position(|&q| q == i).unwrap_or(0);
-                    (1..=self.plan.horizon)
-                        .map(|t| fleet.rank_change(paths, order, rank, paths[i][t - 1], t))
-                        .sum()
+                    fleet.marginal(paths, order, i)
                 })
                 .collect();
             Scores { by_step, marginals }

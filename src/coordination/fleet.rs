@@ -342,6 +342,31 @@ impl Fleet<'_> {
 }
 
 impl Fleet<'_> {
+    /// What the total of `paths` counted in `order` loses without sensor
+    /// `i`'s path, over steps 1..=T (not for first detections). For an
+    /// order-independent estimator that is its value against every other
+    /// path, one value a step; for the paper estimator the sum of
+    /// [`Fleet::rank_change`] (the lower sensors' overlaps change too).
+    pub fn marginal(&self, paths: &[&[Cell]], order: &[usize], i: usize) -> f64 {
+        let s = self.scenario;
+        if self.est.order_independent() {
+            let others: Vec<usize> = order.iter().copied().filter(|&q| q != i).collect();
+            return (1..=self.horizon)
+                .map(|t| {
+                    let looks: Vec<Look> = others
+                        .iter()
+                        .map(|&q| s.look(self.types[q], paths[q][t - 1]))
+                        .collect();
+                    self.est.value(i, paths[i][t - 1], t, &looks)
+                })
+                .sum();
+        }
+        let rank = order.iter().position(|&q| q == i).unwrap_or(0);
+        (1..=self.horizon)
+            .map(|t| self.rank_change(paths, order, rank, paths[i][t - 1], t))
+            .sum()
+    }
+
     /// The change in the total at step `t` of `paths` counted in `order`
     /// when the sensor ranked `rank` stands at `k` instead of being absent:
     /// its own value against the sensors above it, plus the change it

@@ -246,3 +246,55 @@ async fn no_go_cells_and_cut_off_moves_are_refused() {
     ev["paths"][0]["path"] = json!([{"col": 2, "row": 7}, {"col": 1, "row": 9}]);
     json_body(app.post_json("/v1/evaluate", &ev).await, StatusCode::OK).await;
 }
+
+/// A sensor's marginal is what the total loses without its path: scored
+/// again without that sensor (the zone observed whole, so that the sensors
+/// now are not what is known: the value is in a reported target and the
+/// targets entering at the edge they guard), for sensors whose views
+/// overlap (so that the marginals sum to less than the total).
+#[tokio::test]
+async fn a_marginal_is_the_total_less_the_total_without_the_sensor() {
+    let app = spawn_app().await;
+    let sensors: Vec<Value> = [(5.0, 150.0), (15.0, 150.0), (5.0, 160.0), (25.0, 165.0)]
+        .iter()
+        .enumerate()
+        .map(|(i, (x, y))| json!({"id": i, "x": x, "y": y}))
+        .collect();
+    // What the zone holds now is reported whole, so that leaving a sensor
+    // out changes its paths alone, not what is known.
+    let req = json!({"sensors": sensors, "horizon": 3, "coordination": "none",
+        "observed": "zone", "targets": [{"x": 12.0, "y": 155.0, "vx": 1.0, "vy": 0.0}]});
+    let plan = json_body(app.plan(&req).await, StatusCode::OK).await;
+    let paths = paths_of(&plan);
+    let score = |keep: Vec<usize>| {
+        let mut ev = req.clone();
+        ev["sensors"] = Value::Array(keep.iter().map(|&i| sensors[i].clone()).collect());
+        ev["paths"] = Value::Array(keep.iter().map(|&i| paths[i].clone()).collect());
+        let app = &app;
+        async move {
+            json_body(
+                app.post_json("/v1/scenarios/paper-v10/evaluate", &ev).await,
+                StatusCode::OK,
+            )
+            .await
+        }
+    };
+    let all = score((0..4).collect()).await;
+    let total = all["expected_detections"].as_f64().unwrap();
+    let mut sum = 0.0;
+    for i in 0..4 {
+        let without = score((0..4).filter(|&q| q != i).collect()).await;
+        let rest = without["expected_detections"].as_f64().unwrap();
+        let m = all["sensors"][i]["marginal"].as_f64().unwrap();
+        assert!(
+            (m - (total - rest)).abs() <= 1e-9 * total,
+            "sensor {i}: {m} vs {}",
+            total - rest
+        );
+        sum += m;
+    }
+    assert!(
+        total > 0.1 && sum < total - 1e-3,
+        "overlapping views: {sum} against {total}"
+    );
+}
