@@ -32,10 +32,10 @@
 
 use std::sync::Arc;
 
-use super::ExactEstimator;
 use super::cell_sights::{CellSight, CutDetection, CutDetections, cell_sight};
 use super::sight_index::{CellView, hidden_parts};
 use super::windows::{BlockSums, Window};
+use super::{BLOCKS_FROM, ExactEstimator, KnownInViews};
 use crate::estimator::elementary::{ElementaryGrid, Segment, trace};
 use crate::geometry::{Point, detection_pieces};
 use crate::limits::MAX_SPEED_CLASSES;
@@ -239,6 +239,19 @@ impl ExactEstimator<'_> {
         let slot = s.types[ty].fov_slot;
         if let (true, Some((grid, sums))) = (s.sees_over[slot], &windowed) {
             let p_detect = s.types[ty].p_detect;
+            // Many targets: each one's weight added over the block of
+            // cells whose views hold it, in the targets' order, as the
+            // per-cell sum below takes them (the same values to the bit).
+            let reach = (s.types[ty].speed * t) as i32;
+            let cells = ((2 * reach + 1) * (2 * reach + 1)) as usize;
+            if known.len() * cells > BLOCKS_FROM {
+                let blocks = KnownInViews::new(s, ty, start, reach, &[], &known);
+                out.fill_step(t, |dc, dr| {
+                    let k = s.lattice_cell(start, dc, dr)?;
+                    Some(p_detect * (blocks.at(dc, dr) + sums.sum(grid.span(slot, k))))
+                });
+                return;
+            }
             // The reported targets level with a row of cells' views (the
             // cells come row by row): a cell tests only those, in the same
             // order, so it sums the same ones.

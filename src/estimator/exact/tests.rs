@@ -665,7 +665,9 @@ fn detected_upto_is_the_detected_length_up_to_a_point() {
 /// view's containment test holds, counted and summed in the targets'
 /// order: the same to the bit as testing every cell against every target.
 /// Targets on the views' edges, at the zone's edges and partly seen
-/// included, for a square view and for one clipped by the zone.
+/// included, for a square view and for one clipped by the zone; and the
+/// same targets all by weight, as a fill of looks that see over obstacles
+/// sums them.
 #[test]
 fn known_targets_in_views_are_those_each_view_holds() {
     use crate::geometry::Point;
@@ -711,6 +713,12 @@ fn known_targets_in_views_are_those_each_view_holds() {
                 Point::new(0.0, 5.0),
             ]);
             let known = super::KnownInViews::new(&s, ty, start, k, &clear, &partial);
+            // Every target by its weight (1 for the clear ones), in one
+            // list, as a fill of looks that see over obstacles sums them.
+            let weighted: Vec<(Point, f64)> = (clear.iter().map(|&p| (p, 1.0)))
+                .chain(partial.iter().copied())
+                .collect();
+            let by_weight = super::KnownInViews::new(&s, ty, start, k, &[], &weighted);
             let mut fractional = 0;
             for dr in -k..=k {
                 for dc in -k..=k {
@@ -728,6 +736,16 @@ fn known_targets_in_views_are_those_each_view_holds() {
                         known.at(dc, dr).to_bits(),
                         want.to_bits(),
                         "type {ty} start {start:?} offset ({dc}, {dr})"
+                    );
+                    let weight: f64 = weighted
+                        .iter()
+                        .filter(|(p, _)| fk.contains(*p))
+                        .map(|&(_, w)| w)
+                        .sum();
+                    assert_eq!(
+                        by_weight.at(dc, dr).to_bits(),
+                        weight.to_bits(),
+                        "weights: type {ty} start {start:?} offset ({dc}, {dr})"
                     );
                     fractional += usize::from(want.fract() != 0.0);
                 }
