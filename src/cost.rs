@@ -39,8 +39,10 @@
 //! Plan ([`plan_ms`]); `n` sensors, horizon `T`; per sensor and step `t`
 //! its reachable cells `(2vt+1)²` clipped to the lattice and their block of
 //! elementary rectangles; `E`: the sensors whose looks can meet that reach
-//! by step `t` (from the starts); `ov`: the sensors whose field of view
-//! overlaps one cell's (from their density); each search runs per pass:
+//! by step `t` (from the starts); `ov`: the other sensors' looks expected
+//! to meet one look's field of view at step `t`, each placed uniformly
+//! over its reach (from the starts, so a crowded fleet counts every
+//! neighbour); each search runs per pass:
 //! alone, in priority order (excluding half the nearby sensors) and, for
 //! `iterated`, `1 + min(4, Ē/10)` rounds excluding all of them (`Ē` the
 //! mean `E` at step `T`; `1 + min(7, Ē/4)` with the paper estimator;
@@ -48,28 +50,34 @@
 //!
 //! | term | c (ms) | counts |
 //! |---|---:|---|
-//! | 1 | 2.038e-2 | fixed |
-//! | seen: look-rays, certain | 4.110e-6 | rays × looks now and in the history, per class (exact) |
-//! | seen: look-rays, uncertain | 9.124e-5 | the same when `p_detect < 1` |
-//! | seen: sorting pieces | 2.275e-5 | `P·log₂(2 + P/rays)`, `P` = rays × sensors |
-//! | windows: T × look-rays (whole grid) | 5.074e-7 | seen intervals walked over a grid of ≤ 65 536 rectangles |
-//! | windows: T × rects (whole grid) | 3.865e-6 | its unseen mass per step |
-//! | windows: blocks | 2.526e-6 | larger grids: rays × the blocks' size in fields of view |
-//! | fill: cells | 3.864e-5 | reachable cells × passes (values and search) |
-//! | fill: rects × (1 + E in rows) | 7.414e-7 | prefix sums, masked by the excluded looks |
-//! | fill: targets × looks checked | 1.667e-6 | targets in the zone × the excluded looks tried on each |
-//! | fill: cells × clear targets | 4.661e-7 | cells × the targets no excluded look holds |
-//! | general: cells × classes | 3.943e-4 | circles: a ray range per cell and class |
-//! | general: cells × rays × (1 + ov) | 1.351e-5 | its rays, with the overlapping looks |
-//! | general: cells × targets | 1.287e-6 | every reported target per cell |
-//! | sighted: cells × rays near obstacles | 1.137e-5 | a ground look's hidden part by its rays: cells × rays × the share of its reach whose squares meet an obstacle |
-//! | paper: setup | 1.410e-5 | per sensor: `(2vT+1)²` overlaps, targets, 512 escape samples per source and class |
-//! | paper: cells × (seen + E) | 7.086e-7 | per cell: the sensor's targets and the excluded looks |
-//! | paper: cells × ov² | 9.092e-6 | the excluded area's cover |
-//! | paper iterated: cells × n × (1 + ov) | 7.370e-6 | every lower-ranked sensor's change |
+//! | 1 | 1.331e-2 | fixed |
+//! | seen: look-rays, certain | 5.495e-7 | rays × looks now and in the history, per class (exact) |
+//! | seen: look-rays, uncertain | 3.668e-5 | the same when `p_detect < 1` |
+//! | seen: sorting pieces | 2.280e-5 | `P·log₂(2 + P/rays)`, `P` = rays × sensors |
+//! | windows: T × look-rays (whole grid) | 0.000e0 | seen intervals walked over a grid of ≤ 65 536 rectangles |
+//! | windows: T × rects (whole grid) | 5.320e-6 | its unseen mass per step |
+//! | windows: blocks | 8.287e-6 | larger grids: rays × the blocks' size in fields of view |
+//! | fill: cells | 1.115e-5 | reachable cells × passes (values and search) |
+//! | fill: rects × (1 + E in rows) | 0.000e0 | prefix sums, masked by the excluded looks |
+//! | fill: targets × looks checked | 1.155e-7 | targets in the zone × the excluded looks tried on each |
+//! | fill: cells × clear targets | 4.718e-6 | cells × the targets near the reach, tested cell by cell; past `BLOCKS_FROM` cells × targets, cells + targets × a view's width in cells (each target's block, then prefix sums) |
+//! | general: cells × classes | 0.000e0 | circles: a ray range per cell and class |
+//! | general: cells × rays × (1 + ov) | 1.964e-5 | its rays, with the overlapping looks |
+//! | general: cells × targets | 1.165e-6 | every reported target per cell |
+//! | sighted: cells × rays near obstacles | 1.123e-5 | a ground look's hidden part by its rays: cells × rays × the share of its reach whose squares meet an obstacle |
+//! | paper: setup | 1.149e-5 | per sensor: `(2vT+1)²` overlaps, targets, 512 escape samples per source and class |
+//! | paper: cells × (seen + E) | 6.805e-7 | per cell: the sensor's targets and the excluded looks |
+//! | paper: cells × ov² | 5.801e-6 | the excluded area's cover |
+//! | paper iterated: cells × n × (1 + ov) | 7.732e-6 | every lower-ranked sensor's change (× 12 for circles: their cover's quadrature nodes) |
+//! | general uncertain: cells × rays × (looks per ray + ov) | 3.415e-6 | with `p_detect < 1` the seen pieces are kept apart (not one union) and swept with the overlapping looks |
+//! | sighted: cells × rays near obstacles × ov × (1 + obstacles per view) | 2.219e-6 | the same rays cut by the overlapping looks' own shadows (each excluded look an obstacle cuts) |
+//! | fill: partly seen targets × view cells | 2.227e-6 | past `BLOCKS_FROM` cells × targets, each target an excluded uncertain look holds, added over the block of cells whose views hold it |
+//! | paper: cells × ov², circles | 4.803e-5 | the cover of circles: 12 quadrature nodes a slab |
+//! | fill: rects × E in rows, uncertain | 6.515e-6 | the same masks when the looks are uncertain: a rectangle's product of misses never stops at 0, so it tries every look across its row |
 //!
-//! The `sighted` coefficient is fitted alone, the others held, on
-//! `site-campus`'s fleets (`--only campus`; `docs/obstacles.md`).
+//! The `sighted` coefficient was first fitted alone on `site-campus`'s
+//! fleets (`--only campus`; `docs/obstacles.md`); it is now fitted with
+//! the others.
 //!
 //! First detections ([`plan_ms`] with `"objective": "first_detections"`,
 //! whose searches replace the fill and programme above); per sensor `k`
@@ -89,13 +97,14 @@ mod reach;
 
 pub use first::{FIRST_MODEL, FirstTerms, first_terms};
 use reach::{
-    half, iterated_rounds, near_by_step, obstructed_share, rays_per_look, repair_passes,
-    sensor_reach, source_rays,
+    half, iterated_rounds, near_by_step, obstacles_per_view, overlaps_by_step, rays_per_look,
+    repair_passes, sensor_reach, source_rays,
 };
 
 use crate::coordination::{Coordination, Objective};
 use crate::estimator::{
-    INDEX_CROSSINGS_PER_CELL, MAX_SMALL_GRID, MIN_INDEX_CROSSINGS, ONE_WINDOW_RECTANGLES,
+    BLOCKS_FROM, INDEX_CROSSINGS_PER_CELL, MAX_SMALL_GRID, MIN_INDEX_CROSSINGS,
+    ONE_WINDOW_RECTANGLES,
 };
 use crate::geometry::Point;
 use crate::limits::OBSTACLE_STATS_RAYS_PER_PI;
@@ -117,26 +126,37 @@ pub const PRECOMPUTE_MODEL: [(&str, f64); 7] = [
 
 /// The plan model: each term's name and coefficient, milliseconds per unit,
 /// in the order of [`plan_terms`].
-pub const PLAN_MODEL: [(&str, f64); 19] = [
-    ("1", 2.038e-2),
-    ("seen: look-rays, certain", 4.110e-6),
-    ("seen: look-rays, uncertain", 9.124e-5),
-    ("seen: sorting pieces", 2.275e-5),
-    ("windows: T × look-rays (whole grid)", 5.074e-7),
-    ("windows: T × rects (whole grid)", 3.865e-6),
-    ("windows: blocks", 2.526e-6),
-    ("fill: cells", 3.864e-5),
-    ("fill: rects × (1 + E in rows)", 7.414e-7),
-    ("fill: targets × looks checked", 1.667e-6),
-    ("fill: cells × clear targets", 4.661e-7),
-    ("general: cells × classes", 3.943e-4),
-    ("general: cells × rays × (1 + ov)", 1.351e-5),
-    ("general: cells × targets", 1.287e-6),
-    ("sighted: cells × rays near obstacles", 1.137e-5),
-    ("paper: setup", 1.410e-5),
-    ("paper: cells × (seen + E)", 7.086e-7),
-    ("paper: cells × ov²", 9.092e-6),
-    ("paper iterated: cells × n × (1 + ov)", 7.370e-6),
+pub const PLAN_MODEL: [(&str, f64); 24] = [
+    ("1", 1.331e-2),
+    ("seen: look-rays, certain", 5.495e-7),
+    ("seen: look-rays, uncertain", 3.668e-5),
+    ("seen: sorting pieces", 2.280e-5),
+    ("windows: T × look-rays (whole grid)", 0.000e0),
+    ("windows: T × rects (whole grid)", 5.320e-6),
+    ("windows: blocks", 8.287e-6),
+    ("fill: cells", 1.115e-5),
+    ("fill: rects × (1 + E in rows)", 0.000e0),
+    ("fill: targets × looks checked", 1.155e-7),
+    ("fill: cells × clear targets", 4.718e-6),
+    ("general: cells × classes", 0.000e0),
+    ("general: cells × rays × (1 + ov)", 1.964e-5),
+    ("general: cells × targets", 1.165e-6),
+    ("sighted: cells × rays near obstacles", 1.123e-5),
+    ("paper: setup", 1.149e-5),
+    ("paper: cells × (seen + E)", 6.805e-7),
+    ("paper: cells × ov²", 5.801e-6),
+    ("paper iterated: cells × n × (1 + ov)", 7.732e-6),
+    (
+        "general uncertain: cells × rays × (looks per ray + ov)",
+        3.415e-6,
+    ),
+    (
+        "sighted: cells × rays near obstacles × ov × (1 + obstacles per view)",
+        2.219e-6,
+    ),
+    ("fill: partly seen targets × view cells", 2.227e-6),
+    ("paper: cells × ov², circles", 4.803e-5),
+    ("fill: rects × E in rows, uncertain", 6.515e-6),
 ];
 
 /// The units of work of one precomputation, one per term of [`PRECOMPUTE_MODEL`] (same order).
@@ -214,11 +234,23 @@ pub struct PlanTerms {
     pub paper_overlaps: f64,
     /// paper iterated: cells × n × (1 + ov) (`PLAN_MODEL[18]`).
     pub paper_iterated: f64,
+    /// general uncertain: cells × rays × (looks per ray + ov)
+    /// (`PLAN_MODEL[19]`).
+    pub general_uncertain: f64,
+    /// sighted: cells × rays near obstacles × ov × (1 + obstacles per
+    /// view) (`PLAN_MODEL[20]`).
+    pub sighted_cut: f64,
+    /// fill: partly seen targets × view cells (`PLAN_MODEL[21]`).
+    pub fill_partial_targets: f64,
+    /// paper: cells × ov², circles (`PLAN_MODEL[22]`).
+    pub paper_overlaps_circles: f64,
+    /// fill: rects × E in rows, uncertain (`PLAN_MODEL[23]`).
+    pub fill_rects_uncertain: f64,
 }
 
 impl PlanTerms {
     /// The terms in the order of [`PLAN_MODEL`].
-    pub fn to_array(&self) -> [f64; 19] {
+    pub fn to_array(&self) -> [f64; 24] {
         [
             self.constant,
             self.seen_certain,
@@ -239,6 +271,11 @@ impl PlanTerms {
             self.paper_cells,
             self.paper_overlaps,
             self.paper_iterated,
+            self.general_uncertain,
+            self.sighted_cut,
+            self.fill_partial_targets,
+            self.paper_overlaps_circles,
+            self.fill_rects_uncertain,
         ]
     }
 }
@@ -483,8 +520,10 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> PlanTerms {
         constant: 1.0,
         ..PlanTerms::default()
     };
+    let certain = s.types.iter().all(|ty| ty.p_detect == 1.0);
+    // Looks (now and in the history) that cross one ray, on average.
+    let looks_per_ray = look_rays / all_rays.max(1.0);
     if exact {
-        let certain = s.types.iter().all(|ty| ty.p_detect == 1.0);
         if certain {
             t.seen_certain = look_rays;
         } else {
@@ -525,7 +564,14 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> PlanTerms {
         passes.push((repairs, 0.5));
     }
     let zone_area = s.width * s.height;
-    let mean_half = me.iter().map(|m| m.1).sum::<f64>() * cs / n as f64;
+    // The looks that meet one look's field of view, for the paths that
+    // test each cell against them (the grid's prefix sums do not, but the
+    // rays of a look an obstacle cuts do).
+    let overlaps = if grid.is_none() || s.has_obstacles() {
+        overlaps_by_step(s, input)
+    } else {
+        Vec::new()
+    };
     // Per step, for the windows: the reach blocks' bounding box, their
     // total size, and their size in fields of view.
     let mut bbox = vec![(usize::MAX, 0, usize::MAX, 0); stride];
@@ -534,8 +580,8 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> PlanTerms {
     for (i, &(start, _, _)) in me.iter().enumerate() {
         let ty = &s.types[input.types[i]];
         let side = 2.0 * half(ty.fov);
+        let circle = matches!(ty.fov, FovSpec::Circle { .. });
         let a = (side.min(s.width) * side.min(s.height)) / zone_area;
-        let ov = (n - 1) as f64 * ((side + 2.0 * mean_half).powi(2) / zone_area).min(1.0);
         let (own, own_rows) = grid.map_or((1.0, 1.0), |g| {
             let (a0, a1, b0, b1) = g.span(ty.fov_slot, start);
             (
@@ -570,31 +616,73 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> PlanTerms {
             });
             total[step] += rects;
             blocks[step] += rects / own;
-            let near_obstacles = if grid.is_some() && !ty.elevated {
-                obstructed_share(s, lo, hi, half(ty.fov))
+            let per_view = if grid.is_some() && !ty.elevated {
+                obstacles_per_view(s, lo, hi, half(ty.fov))
             } else {
                 0.0
             };
+            let near_obstacles = per_view.min(1.0);
+            // The reported targets a fill reads (those in the reach grown by
+            // a view), and whether it tests each cell against each of them
+            // or counts them per view block (`BLOCKS_FROM`; a ground look
+            // among obstacles always tests).
+            let reach_area = ((f64::from(hi.col - lo.col + 1) * cs + side).min(s.width))
+                * ((f64::from(hi.row - lo.row + 1) * cs + side).min(s.height));
+            let near_targets = in_zone[step] * (reach_area / zone_area).min(1.0);
+            let per_cell =
+                near_targets * cells <= BLOCKS_FROM as f64 || (s.has_obstacles() && !ty.elevated);
+            let span = (side / cs).ceil() + 1.0;
+            let view_cells = (span * span).min(cells);
             for (&(w, share), &miss) in passes.iter().zip(&miss) {
                 let ex = e * share;
                 t.fill_cells += w * cells;
                 if grid.is_some() {
-                    t.fill_rects += w * rects * (1.0 + ex * (own_rows / rows).min(1.0));
+                    let in_rows = ex * (own_rows / rows).min(1.0);
+                    t.fill_rects += w * rects * (1.0 + in_rows);
+                    // Uncertain looks never stop a rectangle's product
+                    // early: it tries every look across its row.
+                    if !certain {
+                        t.fill_rects_uncertain += w * rects * in_rows;
+                    }
                     // A target's check stops at the first look that
                     // holds it: about 1/a looks when they cover a lot.
                     let checks = if a > 0.0 { (1.0 - miss) / a } else { ex };
                     t.fill_targets += w * (known + in_zone[step] * checks);
-                    t.fill_clear_targets += w * cells * in_zone[step] * miss;
+                    if per_cell {
+                        t.fill_clear_targets += w * cells * near_targets;
+                    } else {
+                        // Counted per view block: each target's block
+                        // found along both axes, clear ones added by prefix
+                        // sums, partly seen ones over their block.
+                        t.fill_clear_targets += w * (cells + near_targets * span);
+                        if !certain {
+                            t.fill_partial_targets += w * near_targets * (1.0 - miss) * view_cells;
+                        }
+                    }
                     t.sighted_rays += w * cells * per_look * near_obstacles;
+                    let ov = overlaps.get(i * stride + step).copied().unwrap_or(0.0);
+                    t.sighted_cut +=
+                        w * cells * per_look * near_obstacles * ov * share * (1.0 + per_view);
                 } else if exact {
+                    let ov = overlaps[i * stride + step];
                     t.general_classes += w * cells * classes;
                     t.general_rays += w * cells * per_look * (1.0 + ov * share);
                     t.general_targets += w * cells * known;
+                    if !certain {
+                        t.general_uncertain += w * cells * per_look * (looks_per_ray + ov * share);
+                    }
                 } else {
+                    let ov = overlaps[i * stride + step];
                     t.paper_cells += w * cells * (known * a + ex);
-                    t.paper_overlaps += w * cells * (ov * share).powi(2);
+                    // A circle's cover takes 12 quadrature nodes a slab.
+                    if circle {
+                        t.paper_overlaps_circles += w * cells * (ov * share).powi(2);
+                    } else {
+                        t.paper_overlaps += w * cells * (ov * share).powi(2);
+                    }
                     if share == 1.0 {
-                        t.paper_iterated += w * cells * n as f64 * (1.0 + ov);
+                        let nodes = if circle { 12.0 } else { 1.0 };
+                        t.paper_iterated += w * cells * n as f64 * (1.0 + ov) * nodes;
                     }
                 }
             }

@@ -11,6 +11,13 @@ use crate::stats::angular_span;
 /// of view of half width `h` meets an obstacle's bounding box, from the
 /// boxes grown by `h` (overlaps counted twice, at most 1). O(obstacles).
 pub(super) fn obstructed_share(s: &Scenario, lo: Cell, hi: Cell, h: f64) -> f64 {
+    obstacles_per_view(s, lo, hi, h).min(1.0)
+}
+
+/// The obstacles whose bounding box meets the square field of view of half
+/// width `h` of a cell from `lo` to `hi` (a block), on average over the
+/// block: the shadows a look there casts. O(obstacles).
+pub(super) fn obstacles_per_view(s: &Scenario, lo: Cell, hi: Cell, h: f64) -> f64 {
     let cs = s.cell_size;
     let reach = crate::geometry::Rect {
         x0: f64::from(lo.col) * cs,
@@ -34,7 +41,7 @@ pub(super) fn obstructed_share(s: &Scenario, lo: Cell, hi: Cell, h: f64) -> f64 
             .area()
         })
         .sum();
-    (covered / reach.area()).min(1.0)
+    covered / reach.area()
 }
 
 /// Rays per π of the exact estimator's angular grid on `s`.
@@ -162,4 +169,64 @@ pub(super) fn iterated_rounds(near: &[u32], n: usize, exact: bool) -> f64 {
     } else {
         1.0 + (mean_near / 4.0).min(7.0)
     }
+}
+
+/// `ov[i·(T+1) + t]`: how many other sensors' looks at step `t` are
+/// expected to meet the field of view of sensor `i`'s look at that step,
+/// each look placed uniformly over its sensor's reach (clipped to the
+/// lattice) and "meet" read off the bounding boxes, axis by axis as for
+/// independent coordinates. A fleet spread over the zone gets about its
+/// density times the overlap area; a crowded one gets every neighbour.
+/// O(n²) pairs, each of the pairs that can meet by step `T` once per step.
+pub(super) fn overlaps_by_step(s: &Scenario, input: &PlanInput) -> Vec<f64> {
+    let (n, big_t) = (input.starts.len(), input.horizon);
+    let stride = big_t + 1;
+    let cs = s.cell_size;
+    let me = sensor_reach(s, input);
+    // A look's centre at step t: uniform over the reach's extent, axis by
+    // axis, in the zone's units (at least a cell wide).
+    let extent: Vec<_> = (0..n * stride)
+        .map(|k| {
+            let (start, _, v) = me[k / stride];
+            let (lo, hi) = s.reach_corners(start, (v * (k % stride) as f64) as i32);
+            let x = (f64::from(lo.col) * cs, f64::from(hi.col + 1) * cs);
+            let y = (f64::from(lo.row) * cs, f64::from(hi.row + 1) * cs);
+            (x, y)
+        })
+        .collect();
+    let mut ov = vec![0.0; n * stride];
+    for i in 0..n {
+        let (ci, hi) = (me[i].0, me[i].1 * cs);
+        for j in i + 1..n {
+            let (cj, hj) = (me[j].0, me[j].1 * cs);
+            let w = hi + hj;
+            // Too far apart to meet even at the horizon: every step's
+            // reach lies within the horizon's.
+            let reach = (me[i].2 + me[j].2) * big_t as f64 + 1.0;
+            let apart = (ci.col - cj.col).abs().max((ci.row - cj.row).abs()) as f64;
+            if (apart - reach) * cs >= w {
+                continue;
+            }
+            for t in 1..=big_t {
+                let ((xi, yi), (xj, yj)) = (extent[i * stride + t], extent[j * stride + t]);
+                let p = within(xi, xj, w) * within(yi, yj, w);
+                ov[i * stride + t] += p;
+                ov[j * stride + t] += p;
+            }
+        }
+    }
+    ov
+}
+
+/// `P(|X − Y| < w)` for `X` and `Y` independent and uniform on the
+/// intervals `a` and `b` (each of positive length).
+fn within(a: (f64, f64), b: (f64, f64), w: f64) -> f64 {
+    // X − Y is uniform on a plus uniform on −b: its CDF is a sum of ramps.
+    let (p1, q1, p2, q2) = (a.0, a.1, -b.1, -b.0);
+    let ramp = |x: f64| 0.5 * x.max(0.0).powi(2);
+    let cdf = |z: f64| {
+        (ramp(z - p1 - p2) - ramp(z - q1 - p2) - ramp(z - p1 - q2) + ramp(z - q1 - q2))
+            / ((q1 - p1) * (q2 - p2))
+    };
+    (cdf(w) - cdf(-w)).clamp(0.0, 1.0)
 }

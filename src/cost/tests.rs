@@ -292,3 +292,65 @@ fn the_separation_repair_is_counted_where_pairs_can_meet() {
     // 4 sensors: 15 cells apart, more than 2 + 2·3 steps of reach.
     assert_eq!(cost(4, 2), cost(4, 0));
 }
+
+/// `req` with every sensor (now and in the history) moved into a square
+/// of `half` cells either side of the zone's centre, keeping their order.
+fn crowded(s: &Scenario, mut req: PlanRequest, half: f64) -> PlanRequest {
+    let (cx, cy) = (s.width / 2.0, s.height / 2.0);
+    let f = half * s.cell_size / cx;
+    let squeeze = |x: &mut f64, y: &mut f64| {
+        *x = cx + (*x - cx) * f;
+        *y = cy + (*y - cy) * f;
+    };
+    for p in &mut req.sensors {
+        squeeze(&mut p.x, &mut p.y);
+    }
+    for p in req.history.iter_mut().flatten().flatten() {
+        squeeze(&mut p.x, &mut p.y);
+    }
+    req
+}
+
+/// A fleet crowded within a few cells costs more than the same fleet
+/// spread over the zone where each value tests the looks that overlap
+/// its view (the paper estimator's cover, the exact estimator's rays
+/// through circles), and uncertain looks through circles more than
+/// certain ones; the windows' block sums of squares, which a crowd does
+/// not slow as much, are not what this measures.
+#[test]
+fn crowded_fleets_and_uncertain_circles_cost_more() {
+    let p = Planner::new(builtins().remove(0));
+    let paper = |req: PlanRequest| {
+        let mut req = req;
+        req.estimator = Some(EstimatorKind::Paper);
+        plan_cost(&p, req, Iterated)
+    };
+    let spread = request(&p.scenario, 32, 3, 0, 8);
+    let crowd = crowded(&p.scenario, spread.clone(), 3.0);
+    assert!(
+        paper(crowd.clone()) > 5.0 * paper(spread.clone()),
+        "paper: {} vs {}",
+        paper(crowd),
+        paper(spread)
+    );
+    let circles = |p_detect: f64| {
+        let mut spec = paper_spec(10.0);
+        spec.fov = FovSpec::Circle { radius: 30.0 };
+        spec.p_detect = Some(p_detect);
+        Planner::new(Scenario::new(spec).expect("valid"))
+    };
+    let certain = circles(1.0);
+    let spread = request(&certain.scenario, 32, 3, 0, 8);
+    let crowd = crowded(&certain.scenario, spread.clone(), 3.0);
+    let (a, b) = (
+        plan_cost(&certain, crowd, Priority),
+        plan_cost(&certain, spread.clone(), Priority),
+    );
+    assert!(a > 3.0 * b, "circles: {a} vs {b}");
+    let uncertain = circles(0.7);
+    let (c, d) = (
+        plan_cost(&uncertain, spread.clone(), Priority),
+        plan_cost(&certain, spread, Priority),
+    );
+    assert!(c > 1.5 * d, "uncertain circles: {c} vs {d}");
+}

@@ -16,7 +16,7 @@ mod paper;
 
 pub use elementary::{ElementaryGrid, MAX_SMALL_GRID};
 pub use exact::{
-    Carry, CarryUse, ExactEstimator, FirstDetections, INDEX_CROSSINGS_PER_CELL,
+    BLOCKS_FROM, Carry, CarryUse, ExactEstimator, FirstDetections, INDEX_CROSSINGS_PER_CELL,
     MIN_INDEX_CROSSINGS, ONE_WINDOW_RECTANGLES, PathCover, Precomputed, RAYS_PER_PI,
     RAYS_PER_PI_SQUARE, SightIndex, Situation, SourceRays,
 };

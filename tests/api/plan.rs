@@ -302,7 +302,7 @@ async fn plans_on_the_async_worker_answer_as_on_the_pool() {
     let sensors: Vec<Value> = (0..48)
         .map(|i| json!({"id": i, "x": 5.0 + f64::from(i % 8) * 40.0, "y": 5.0 + f64::from(i / 8) * 50.0}))
         .collect();
-    let long = json!({"sensors": sensors, "horizon": 6, "coordination": "iterated"});
+    let long = json!({"sensors": sensors, "horizon": 10, "coordination": "iterated"});
     let input = vigil::planner::PlanInput::new(
         &planner.scenario,
         &serde_json::from_value(long.clone()).unwrap(),

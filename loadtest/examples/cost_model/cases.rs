@@ -219,6 +219,26 @@ impl Builder {
     }
 }
 
+/// `req` with every position (now and in the history) moved towards the
+/// zone's centre, into a square of `half` cells either side of it.
+fn crowd(s: &Scenario, req: &PlanRequest, half: f64) -> PlanRequest {
+    let (cx, cy) = (0.5 * s.width, 0.5 * s.height);
+    let (fx, fy) = (
+        half * s.cell_size / (0.5 * s.width),
+        half * s.cell_size / (0.5 * s.height),
+    );
+    let mut r = req.clone();
+    for sensor in &mut r.sensors {
+        sensor.x = cx + (sensor.x - cx) * fx;
+        sensor.y = cy + (sensor.y - cy) * fy;
+    }
+    for p in r.history.iter_mut().flatten().flatten() {
+        p.x = cx + (p.x - cx) * fx;
+        p.y = cy + (p.y - cy) * fy;
+    }
+    r
+}
+
 fn set(req: &PlanRequest, f: impl FnOnce(&mut PlanRequest)) -> PlanRequest {
     let mut r = req.clone();
     f(&mut r);
@@ -431,6 +451,119 @@ pub fn plan_cases(b: &mut Builder) {
             let r = set(&r, |r| r.history = None);
             b.plan(Extra, format!("circle r30 n{n} T{t} h0"), circ, r);
         }
+    }
+
+    // Uncertain looks through circles: the seen pieces kept apart.
+    let circ_p = b.planner(
+        Scenario::new(ScenarioSpec {
+            fov: circle(30.0),
+            p_detect: Some(0.7),
+            ..paper_spec(10.0)
+        })
+        .unwrap(),
+    );
+    for (n, t, h, c) in [
+        (10usize, 3usize, 16usize, Coordination::Priority),
+        (32, 6, 16, Coordination::Priority),
+        (16, 3, 32, Coordination::Iterated),
+        (10, 3, 0, Coordination::Priority),
+    ] {
+        let r = b.requests(circ_p, &mix(n, t, h), 1).remove(0);
+        let r = set(&r, |r| r.coordination = Some(c));
+        b.plan(
+            Extra,
+            format!("circle r30 p0.7 n{n} T{t} h{h} {c:?}"),
+            circ_p,
+            r,
+        );
+    }
+
+    // Many obstacles near ground sensors, and a crowded ground fleet among
+    // buildings: the excluded looks' own shadows cut each ray.
+    let yard64 = b.planner(yard(64, 8, square(30.0)));
+    for (n, t, c) in [
+        (32usize, 6usize, Coordination::Priority),
+        (16, 3, Coordination::Iterated),
+    ] {
+        let r = b.requests(yard64, &mix(n, t, 16), 1).remove(0);
+        let r = set(&r, |r| r.coordination = Some(c));
+        b.plan(Extra, format!("yard 64×8 n{n} T{t} {c:?}"), yard64, r);
+    }
+    for (n, t, c) in [
+        (64usize, 3usize, Coordination::Priority),
+        (32, 3, Coordination::Iterated),
+    ] {
+        let r = b.requests(campus, &mix(n, t, 8), 1).remove(0);
+        let sc = &b.planners[campus].scenario;
+        let free = |x: f64, y: f64| sc.is_free(0, sc.snap(vigil::geometry::Point::new(x, y)));
+        let r = set(&crowd(sc, &r, 4.0), |r| {
+            r.coordination = Some(c);
+            // Those that the crowding put on a building stay out.
+            r.sensors.retain(|p| free(p.x, p.y));
+            for step in r.history.iter_mut().flatten() {
+                step.retain(|p| free(p.x, p.y));
+            }
+        });
+        b.plan(
+            Extra,
+            format!("crowded site-campus n{n} T{t} {c:?}"),
+            campus,
+            r,
+        );
+    }
+
+    // Drones (uncertain, fast) among many reported targets (the targets
+    // the excluded looks partly see, counted per view block), and many
+    // drones (each view's rectangles masked by many looks).
+    for (n, t, targets, c) in [
+        (64usize, 6usize, 2000usize, Coordination::Iterated),
+        (32, 3, 5000, Coordination::Priority),
+        (128, 6, 200, Coordination::Iterated),
+        (256, 3, 200, Coordination::Iterated),
+    ] {
+        let spec = format!("drone:{n}");
+        let types =
+            vigil_sim::driver::fleet_types(&b.planners[fleet].scenario, Some(&spec), n).unwrap();
+        let r = mix(n, t, 8)
+            .requests_of_fleet(&b.planners[fleet], 1, types)
+            .remove(0);
+        let r = with_targets(&b.planners[fleet].scenario, &r, targets);
+        let r = set(&r, |r| r.coordination = Some(c));
+        b.plan(
+            Extra,
+            format!("site-fleet {spec} T{t} tg{targets} {c:?}"),
+            fleet,
+            r,
+        );
+    }
+
+    // Crowded fleets: every sensor within a few cells of the others, so
+    // that each look meets most of the others' (the paper estimator's
+    // cover, the exact estimator's rays through circles).
+    for (n, t, c, e, p) in [
+        (
+            16usize,
+            3usize,
+            Coordination::Priority,
+            EstimatorKind::Paper,
+            pv10,
+        ),
+        (64, 3, Coordination::Priority, EstimatorKind::Paper, pv10),
+        (32, 3, Coordination::Iterated, EstimatorKind::Paper, pv10),
+        (64, 2, Coordination::Iterated, EstimatorKind::Paper, pv15),
+        (32, 3, Coordination::Priority, EstimatorKind::Paper, circ),
+        (16, 3, Coordination::Iterated, EstimatorKind::Paper, circ),
+        (64, 3, Coordination::Priority, EstimatorKind::Exact, circ),
+        (16, 6, Coordination::Iterated, EstimatorKind::Exact, circ),
+    ] {
+        let r = b.requests(p, &mix(n, t, 8), 1).remove(0);
+        let r = crowd(&b.planners[p].scenario, &r, 3.0);
+        let r = set(&r, |r| {
+            r.coordination = Some(c);
+            r.estimator = Some(e);
+        });
+        let name = &b.planners[p].scenario.id;
+        b.plan(Extra, format!("crowded {name} n{n} T{t} {c:?} {e:?}"), p, r);
     }
 
     // The large plans.

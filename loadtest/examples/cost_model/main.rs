@@ -6,7 +6,9 @@
 //! and each quantity varied from it: horizon, sensors, reported targets,
 //! history, coordination, minimum separation, estimator, `site-gates`' speed
 //! classes, `site-fleet`'s fleets), more plans that spread the fit (larger
-//! lattices, circular fields of view, combinations), the large
+//! lattices, circular fields of view, combinations, crowded fleets,
+//! uncertain looks through circles, many obstacles, many drones among
+//! many targets), the large
 //! plans, plans that maximise first detections (horizons, coordinations,
 //! sensors, the built-ins' fleets; `cases::first_cases`), and
 //! precomputations (lattice size, fields of view, sources, sensor types,
@@ -32,7 +34,7 @@
 //! prints the refitted constants in the form of `src/cost.rs`, then each
 //! case with the prediction of the model in `src/cost.rs` and of the
 //! refit, and the median, lowest and highest ratio predicted/measured per
-//! group. About 1 min 45 s and 30 s more for the first-detections cases
+//! group. About 3 min 15 s and 30 s more for the first-detections cases
 //! (whose names start with `first`: `--only first` runs them alone); 15 s
 //! more with `--large`.
 //!

@@ -753,7 +753,7 @@ impl Estimator for ExactEstimator<'_> {
 /// Cells × known targets past which a windowed fill counts the targets
 /// per view block ([`KnownInViews`]) rather than testing every cell
 /// against every target (the two give the same values).
-const BLOCKS_FROM: usize = 2048;
+pub const BLOCKS_FROM: usize = 2048;
 
 /// The known targets in the square field of view of a sensor's type at
 /// every cell within `k` cells of its start: those no excluded look holds
