@@ -315,21 +315,32 @@ impl<'p> Evaluator<'p> {
     /// total without its path), or the change in the total without it
     /// (paper: its own value and the overlap reductions it causes below
     /// it).
-    pub fn score(&self, paths: &[&[Cell]], order: &[usize]) -> Scores {
+    ///
+    /// # Errors
+    /// [`Cancelled`] once `cancel` is cancelled (checked before each
+    /// sensor's marginal: with the paper estimator one re-scores every
+    /// lower sensor whose view it overlaps).
+    pub fn score(
+        &self,
+        paths: &[&[Cell]],
+        order: &[usize],
+        cancel: &CancelToken,
+    ) -> Result<Scores, Cancelled> {
         self.with_fleet(|fleet| {
             let by_step = fleet.by_step(paths, order);
             let marginals = (0..paths.len())
                 .map(|i| {
+                    cancel.check()?;
                     if fleet.first.is_some() {
                         let others: Vec<usize> =
                             order.iter().copied().filter(|&q| q != i).collect();
-                        return by_step.iter().sum::<f64>()
-                            - fleet.by_step(paths, &others).iter().sum::<f64>();
+                        return Ok(by_step.iter().sum::<f64>()
+                            - fleet.by_step(paths, &others).iter().sum::<f64>());
                     }
-                    fleet.marginal(paths, order, i)
+                    Ok(fleet.marginal(paths, order, i))
                 })
-                .collect();
-            Scores { by_step, marginals }
+                .collect::<Result<_, Cancelled>>()?;
+            Ok(Scores { by_step, marginals })
         })
     }
 }
@@ -347,7 +358,7 @@ impl Planner {
         let evaluator = Evaluator::new(self, &input.plan, cancel)?;
         cancel.check()?;
         let paths: Vec<&[Cell]> = input.paths.iter().map(Vec::as_slice).collect();
-        let Scores { by_step, marginals } = evaluator.score(&paths, &input.order);
+        let Scores { by_step, marginals } = evaluator.score(&paths, &input.order, cancel)?;
         cancel.check()?;
         let d = input.plan.min_separation;
         let violations = separation::count(&input.paths, d);
