@@ -364,6 +364,51 @@ pub fn plan_ms(planner: &Planner, input: &PlanInput) -> f64 {
     }
 }
 
+/// Milliseconds per unit of the paper estimator's marginals in an
+/// evaluate: `m²·(1 + m)·nodes` per sensor and step, `m` the other looks
+/// that meet its view (a marginal re-scores each lower sensor it
+/// overlaps, each value a cover of about `m²`), `nodes` 12 for a circle's
+/// quadrature and 1 for a square. Measured in `docs/performance.md` (*The
+/// cost model*).
+const EVALUATE_PAPER_MS_PER_COVER: f64 = 6.0e-7;
+
+/// Predicted CPU time of scoring `paths` (one per sensor of `input`, its
+/// cells at steps 1..=T) on `planner`, milliseconds on one core: the
+/// estimator's preparation and one value per sensor and step are less
+/// than a plan without coordination ([`plan_ms`] of it); with the paper
+/// estimator, whose marginals re-score the sensors below each one, the
+/// covers they take on top. O(sensors² × T).
+pub fn evaluate_ms(
+    planner: &Planner,
+    input: &PlanInput,
+    paths: &[Vec<crate::scenario::Cell>],
+) -> f64 {
+    let mut uncoordinated = input.clone();
+    uncoordinated.coordination = Coordination::None;
+    let base = plan_ms(planner, &uncoordinated);
+    if input.estimator != EstimatorKind::Paper {
+        return base;
+    }
+    let s = &planner.scenario;
+    let mut covers = 0.0;
+    for t in 0..input.horizon {
+        let views: Vec<_> = (paths.iter().zip(&input.types))
+            .filter_map(|(path, &ty)| Some((s.fov_region_of(ty, *path.get(t)?).rect, ty)))
+            .collect();
+        for (i, (a, ty)) in views.iter().enumerate() {
+            let m = (views.iter().enumerate())
+                .filter(|&(q, (b, _))| q != i && !a.intersect(b).is_empty())
+                .count() as f64;
+            let nodes = match s.types[*ty].fov {
+                FovSpec::Circle { .. } => 12.0,
+                FovSpec::Square { .. } => 1.0,
+            };
+            covers += m * m * (1.0 + m) * nodes;
+        }
+    }
+    base + EVALUATE_PAPER_MS_PER_COVER * covers
+}
+
 /// The first [`PLAN_MODEL`] terms, up to `fill: cells`: the estimator a
 /// plan builds before its searches (its seen sets and windows).
 pub const ESTIMATOR_TERMS: usize = 7;

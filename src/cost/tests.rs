@@ -354,3 +354,35 @@ fn crowded_fleets_and_uncertain_circles_cost_more() {
     );
     assert!(c > 1.5 * d, "uncertain circles: {c} vs {d}");
 }
+
+/// An evaluate with the paper estimator costs the covers of its
+/// marginals on top of a plan without coordination: far more for a fleet
+/// whose views overlap (and for circles than squares); with the exact
+/// estimator it is that plan's cost.
+#[test]
+fn evaluate_counts_the_paper_estimators_marginals() {
+    let p = Planner::new(builtins().remove(0));
+    let cost = |req: &PlanRequest, estimator: EstimatorKind| {
+        let mut req = req.clone();
+        req.estimator = Some(estimator);
+        let input = PlanInput::new(&p.scenario, &req).expect("valid");
+        // Every sensor stays where it stands.
+        let paths: Vec<Vec<Cell>> = (input.starts.iter())
+            .map(|&c| vec![c; input.horizon])
+            .collect();
+        let mut none = input.clone();
+        none.coordination = Coordination::None;
+        (evaluate_ms(&p, &input, &paths), plan_ms(&p, &none))
+    };
+    let spread = request(&p.scenario, 64, 6, 0, 8);
+    let crowd = crowded(&p.scenario, spread.clone(), 3.0);
+    let (exact, plan) = cost(&crowd, EstimatorKind::Exact);
+    assert_eq!(exact, plan);
+    let (crowded_paper, plan) = cost(&crowd, EstimatorKind::Paper);
+    let (spread_paper, _) = cost(&spread, EstimatorKind::Paper);
+    assert!(crowded_paper > 10.0 * plan, "{crowded_paper} vs {plan}");
+    assert!(
+        crowded_paper > 5.0 * spread_paper,
+        "{crowded_paper} vs {spread_paper}"
+    );
+}

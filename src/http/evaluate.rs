@@ -12,7 +12,6 @@ use super::extract::{Json, Path, QueuedJson};
 use super::middleware::RequestStart;
 use super::planning::{CancelOnDrop, refuse_if_costly, with_scenario};
 use super::state::AppState;
-use crate::coordination::Coordination;
 use crate::cost;
 use crate::evaluate::{EvaluateInput, EvaluateRequest, EvaluateResponse};
 use crate::planner::Planner;
@@ -26,11 +25,7 @@ async fn evaluate_admitted(
     req: &EvaluateRequest,
 ) -> Result<EvaluateResponse, ApiError> {
     let input = EvaluateInput::new(&planner, req)?;
-    // Scoring is the estimator's preparation and one value per sensor and
-    // step: less than a plan without coordination, the bound used.
-    let mut uncoordinated = input.plan.clone();
-    uncoordinated.coordination = Coordination::None;
-    let predicted_ms = cost::plan_ms(&planner, &uncoordinated);
+    let predicted_ms = cost::evaluate_ms(&planner, &input.plan, &input.paths);
     refuse_if_costly(state, predicted_ms)?;
     let guard = CancelOnDrop::new("evaluate", start, state);
     let token = guard.token();
