@@ -230,3 +230,25 @@ fn within(a: (f64, f64), b: (f64, f64), w: f64) -> f64 {
     };
     (cdf(w) - cdf(-w)).clamp(0.0, 1.0)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::within;
+
+    /// Against areas worked by hand: two unit intervals within 1/2 of each
+    /// other 1 − (1/2)² = 3/4; `[0, 2]` against `[0, 1]` within 1/2,
+    /// 0.875 / 2; intervals too far apart 0, and a width past both 1.
+    #[test]
+    fn within_is_the_chance_that_two_uniforms_are_close() {
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        assert!(close(within((0.0, 1.0), (0.0, 1.0), 0.5), 0.75));
+        assert!(close(within((0.0, 2.0), (0.0, 1.0), 0.5), 0.4375));
+        assert!(close(within((0.0, 1.0), (0.0, 2.0), 0.5), 0.4375));
+        assert!(close(
+            within((1e5, 1e5 + 10.0), (1e5 + 5.0, 1e5 + 15.0), 5.0),
+            0.5
+        ));
+        assert_eq!(within((0.0, 1.0), (5.0, 6.0), 1.0), 0.0);
+        assert!(close(within((0.0, 2.0), (0.0, 1.0), 10.0), 1.0));
+    }
+}
