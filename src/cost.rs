@@ -68,11 +68,11 @@
 //! | paper: setup | 1.149e-5 | per sensor: `(2vT+1)²` overlaps, targets, 512 escape samples per source and class |
 //! | paper: cells × (seen + E) | 6.805e-7 | per cell: the sensor's targets and the excluded looks |
 //! | paper: cells × ov² | 5.801e-6 | the excluded area's cover |
-//! | paper iterated: cells × n × (1 + ov) | 7.732e-6 | every lower-ranked sensor's change (× 12 for circles: their cover's quadrature nodes) |
+//! | paper iterated: cells × n × (1 + ov) | 7.732e-6 | every lower-ranked sensor's change (× `geometry::CURVED_SLAB_NODES` for circles: their cover's quadrature nodes) |
 //! | general uncertain: cells × rays × (looks per ray + ov) | 3.415e-6 | with `p_detect < 1` the seen pieces are kept apart (not one union) and swept with the overlapping looks |
 //! | sighted: cells × rays near obstacles × ov × (1 + obstacles per view) | 2.219e-6 | the same rays cut by the overlapping looks' own shadows (each excluded look an obstacle cuts) |
 //! | fill: partly seen targets × view cells | 2.227e-6 | past `BLOCKS_FROM` cells × targets, each target an excluded uncertain look holds, added over the block of cells whose views hold it |
-//! | paper: cells × ov², circles | 4.803e-5 | the cover of circles: 12 quadrature nodes a slab |
+//! | paper: cells × ov², circles | 4.803e-5 | the cover of circles: `geometry::CURVED_SLAB_NODES` quadrature nodes a slab |
 //! | fill: rects × E in rows, uncertain | 6.515e-6 | the same masks when the looks are uncertain: a rectangle's product of misses never stops at 0, so it tries every look across its row |
 //!
 //! The `sighted` coefficient was first fitted alone on `site-campus`'s
@@ -106,7 +106,7 @@ use crate::estimator::{
     BLOCKS_FROM, INDEX_CROSSINGS_PER_CELL, MAX_SMALL_GRID, MIN_INDEX_CROSSINGS,
     ONE_WINDOW_RECTANGLES,
 };
-use crate::geometry::Point;
+use crate::geometry::{CURVED_SLAB_NODES, Point};
 use crate::limits::OBSTACLE_STATS_RAYS_PER_PI;
 use crate::planner::{EstimatorKind, Observed, PlanInput, Planner};
 use crate::scenario::{FovSpec, Scenario, Source};
@@ -400,7 +400,7 @@ pub fn evaluate_ms(
                 .filter(|&(q, (b, _))| q != i && !a.intersect(b).is_empty())
                 .count() as f64;
             let nodes = match s.types[*ty].fov {
-                FovSpec::Circle { .. } => 12.0,
+                FovSpec::Circle { .. } => CURVED_SLAB_NODES as f64,
                 FovSpec::Square { .. } => 1.0,
             };
             covers += m * m * (1.0 + m) * nodes;
@@ -719,14 +719,18 @@ pub fn plan_terms(planner: &Planner, input: &PlanInput) -> PlanTerms {
                 } else {
                     let ov = overlaps[i * stride + step];
                     t.paper_cells += w * cells * (known * a + ex);
-                    // A circle's cover takes 12 quadrature nodes a slab.
+                    // A circle's cover takes `CURVED_SLAB_NODES` a slab.
                     if circle {
                         t.paper_overlaps_circles += w * cells * (ov * share).powi(2);
                     } else {
                         t.paper_overlaps += w * cells * (ov * share).powi(2);
                     }
                     if share == 1.0 {
-                        let nodes = if circle { 12.0 } else { 1.0 };
+                        let nodes = if circle {
+                            CURVED_SLAB_NODES as f64
+                        } else {
+                            1.0
+                        };
                         t.paper_iterated += w * cells * n as f64 * (1.0 + ov) * nodes;
                     }
                 }

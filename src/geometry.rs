@@ -296,11 +296,7 @@ impl Region {
         xs.sort_by(f64::total_cmp);
         xs.dedup();
         let curved = self.disk.is_some() || others.iter().any(|o| o.0.disk.is_some());
-        let (nodes, weights) = if curved {
-            gauss_legendre(12)
-        } else {
-            gauss_legendre(1)
-        };
+        let (nodes, weights) = gauss_legendre(if curved { CURVED_SLAB_NODES } else { 1 });
         let mut chords: Vec<(f64, f64)> = Vec::with_capacity(others.len());
         let mut weighted: Vec<(f64, f64, f64)> = Vec::new();
         let mut events = Vec::new();
@@ -617,6 +613,11 @@ pub(crate) fn clip_half_plane(poly: &[Point], side: impl Fn(Point) -> f64) -> Ve
     }
     out
 }
+
+/// Gauss–Legendre nodes per slab between breakpoints of a cover with a
+/// disk (see [`Region::covered_area`]); straight edges need one. The cost
+/// model counts a curved cover's work by it.
+pub const CURVED_SLAB_NODES: usize = 12;
 
 static GL: LazyLock<Vec<(Vec<f64>, Vec<f64>)>> =
     LazyLock::new(|| (0..=32).map(compute_gauss_legendre).collect());
