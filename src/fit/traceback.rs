@@ -76,7 +76,8 @@ pub fn explaining(s: &Scenario, q: Point, w: Point, tol: &Tolerance) -> Vec<(usi
 
 /// Where the track of a detection at `q` moving `w` per step entered the
 /// zone: its line traced back to the zone's edge (`q` itself for a target
-/// that does not move).
+/// that does not move, or for a `q` outside the zone whose line, traced
+/// back, never crosses it).
 pub fn entry(s: &Scenario, q: Point, w: Point) -> Point {
     let speed = w.x.hypot(w.y);
     if speed <= 0.0 {
@@ -87,5 +88,38 @@ pub fn entry(s: &Scenario, q: Point, w: Point) -> Point {
     match s.zone().ray(q, back, inv) {
         Some((_, t1)) => Point::new(q.x + back.x * t1, q.y + back.y * t1),
         None => q,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::builtins;
+
+    /// A track inside the zone enters on the edge its line meets behind
+    /// it; one outside that, traced back, crosses the zone enters on the
+    /// far side; one outside that never crosses it, and a target at rest,
+    /// keep the detection's position.
+    #[test]
+    fn entry_is_where_the_line_behind_the_detection_meets_the_edge() {
+        let s = &builtins()[0];
+        let z = s.zone();
+        let (mx, my) = ((z.x0 + z.x1) / 2.0, (z.y0 + z.y1) / 2.0);
+        let close = |a: Point, b: Point| (a.x - b.x).abs() < 1e-9 && (a.y - b.y).abs() < 1e-9;
+        // Inside, flying east: entered on the west edge, at its height.
+        let e = entry(s, Point::new(mx, my), Point::new(1.0, 0.0));
+        assert!(close(e, Point::new(z.x0, my)), "{e:?}");
+        // East of the zone, flying east: it crossed the zone from the west.
+        let e = entry(s, Point::new(z.x1 + 5.0, my), Point::new(2.0, 0.0));
+        assert!(close(e, Point::new(z.x0, my)), "{e:?}");
+        // East of the zone, flying west: it never crossed the zone.
+        let q = Point::new(z.x1 + 5.0, my);
+        assert!(close(entry(s, q, Point::new(-1.0, 0.0)), q));
+        // Above the zone, flying east along it: never in it.
+        let q = Point::new(mx, z.y1 + 1.0);
+        assert!(close(entry(s, q, Point::new(1.0, 0.0)), q));
+        // At rest.
+        let q = Point::new(mx, my);
+        assert!(close(entry(s, q, Point::new(0.0, 0.0)), q));
     }
 }

@@ -161,7 +161,9 @@ pub struct Unexplained {
     /// Its track id.
     pub id: Id,
     /// Where its track, traced back from its first detection, entered the
-    /// zone.
+    /// zone; the first detection's own position for a track that, traced
+    /// back, never crossed the zone (a detection outside it, which a wide
+    /// `tolerance.look` admits) or for a target that does not move.
     pub entry: PointOut,
 }
 
