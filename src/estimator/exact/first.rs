@@ -50,7 +50,7 @@ struct Piece {
 /// detected length before each within its key: what is already detected
 /// (or, for a search, detected or counted by another sensor).
 #[derive(Debug, Default)]
-struct Profile {
+pub(super) struct Profile {
     /// `ends[start[i]..start[i + 1]]` belong to the `i`-th key listed.
     start: Vec<u32>,
     /// Each piece's end `x1`, apart so that [`Profile::upto`]'s search
@@ -77,7 +77,7 @@ const SCAN_PIECES: usize = 32;
 
 impl Profile {
     /// Appends one key's sorted disjoint pieces.
-    fn push_key(&mut self, pieces: impl IntoIterator<Item = (f64, f64, f64)>) {
+    pub(super) fn push_key(&mut self, pieces: impl IntoIterator<Item = (f64, f64, f64)>) {
         if self.start.is_empty() {
             self.start.push(0);
         }
@@ -106,24 +106,58 @@ impl Profile {
         (self.known[lo..hi].iter().zip(&self.ends[lo..hi])).map(|(k, &x1)| (k.x0, x1, k.detected))
     }
 
+    /// The `i`-th key's piece ends and the rest of its pieces.
+    fn key(&self, i: usize) -> (&[f64], &[Known]) {
+        let (lo, hi) = (self.start[i] as usize, self.start[i + 1] as usize);
+        (&self.ends[lo..hi], &self.known[lo..hi])
+    }
+
     /// `∫_{−∞}^x detected` over the `i`-th key's pieces.
     fn upto(&self, i: usize, x: f64) -> f64 {
-        let (lo, hi) = (self.start[i] as usize, self.start[i + 1] as usize);
-        // The first piece that ends after x: the ends are sorted, so it
-        // follows the ends at or before x.
-        let ends = &self.ends[lo..hi];
-        let j = if ends.len() <= SCAN_PIECES {
-            ends.iter().filter(|&&e| e <= x).count()
-        } else {
-            ends.partition_point(|&e| e <= x)
-        };
-        match self.known[lo..hi].get(j) {
-            Some(k) if x > k.x0 => k.before + (x - k.x0) * k.detected,
-            Some(k) => k.before,
-            None => self.known[lo..hi].last().map_or(0.0, |k| {
-                k.before + (ends[ends.len() - 1] - k.x0) * k.detected
-            }),
+        let (ends, known) = self.key(i);
+        upto_from(ends, known, first_ending_after(ends, x), x)
+    }
+
+    /// `∫_{−∞}^a` and `∫_{−∞}^b` of what the `i`-th key's pieces detect,
+    /// unless they detect every point of `[a, b]` for certain (pieces
+    /// detected with probability 1 meet end to end from `a` to `b`): then
+    /// `None`.
+    pub(super) fn ends_unless_detected(&self, i: usize, a: f64, b: f64) -> Option<(f64, f64)> {
+        let (ends, known) = self.key(i);
+        let j = first_ending_after(ends, a);
+        let mut reached = a;
+        for (k, &end) in known[j..].iter().zip(&ends[j..]) {
+            if k.x0 > reached || k.detected != 1.0 {
+                break;
+            }
+            reached = end;
+            if reached >= b {
+                return None;
+            }
         }
+        Some((upto_from(ends, known, j, a), self.upto(i, b)))
+    }
+}
+
+/// The first of a key's pieces that ends after `x` (their ends are
+/// sorted, so it follows the ends at or before `x`).
+fn first_ending_after(ends: &[f64], x: f64) -> usize {
+    if ends.len() <= SCAN_PIECES {
+        ends.iter().filter(|&&e| e <= x).count()
+    } else {
+        ends.partition_point(|&e| e <= x)
+    }
+}
+
+/// `∫_{−∞}^x detected` over a key's pieces, `j` the first that ends
+/// after `x`.
+fn upto_from(ends: &[f64], known: &[Known], j: usize, x: f64) -> f64 {
+    match known.get(j) {
+        Some(k) if x > k.x0 => k.before + (x - k.x0) * k.detected,
+        Some(k) => k.before,
+        None => known.last().map_or(0.0, |k| {
+            k.before + (ends[ends.len() - 1] - k.x0) * k.detected
+        }),
     }
 }
 
@@ -369,7 +403,8 @@ impl<'e> FirstDetections<'e> {
     /// The pieces of the looks of `sensors` on `paths` (`paths[q][t − 1]`
     /// at step `t`), step by step in the order of `sensors`: the same as
     /// [`FirstDetections::pieces_of`] their looks, read from each sensor's
-    /// stops where its search built them.
+    /// stops where its search built them (which leave out the pieces the
+    /// history detected for certain: a background detects them already).
     fn pieces_on(&self, paths: &[&[Cell]], sensors: &[usize], horizon: usize) -> Vec<Piece> {
         let s = self.est.scenario;
         let mut buf = PieceScratch::default();
@@ -386,8 +421,8 @@ impl<'e> FirstDetections<'e> {
         pieces
     }
 
-    /// The pieces of sensor `q`'s look at `cell` at step `t`, if its
-    /// search built them.
+    /// The pieces of sensor `q`'s look at `cell` at step `t` that the
+    /// history did not detect for certain, if its search built them.
     fn stop_pieces(&self, q: usize, t: usize, cell: Cell) -> Option<&[Piece]> {
         let stops = self.stops[q].get()?;
         let offset = (cell.col - stops.start.col, cell.row - stops.start.row);
@@ -541,12 +576,23 @@ impl<'e> FirstDetections<'e> {
                         return;
                     };
                     self.pieces_at(&held[range.clone()], p_detect, t, &mut stops.pieces);
-                    stops
-                        .history_ends
-                        .extend(stops.pieces[first..].iter().map(|p| {
-                            let key = p.key as usize;
-                            (self.history.upto(key, p.a), self.history.upto(key, p.b))
-                        }));
+                    // A piece whose targets the history detected for
+                    // certain adds nothing, alone or on top of others, and
+                    // takes nothing from the pieces it overlaps (the
+                    // background detects every point of it): left out.
+                    let mut kept = first;
+                    for k in first..stops.pieces.len() {
+                        let p = stops.pieces[k];
+                        let Some(ends) =
+                            self.history.ends_unless_detected(p.key as usize, p.a, p.b)
+                        else {
+                            continue;
+                        };
+                        stops.pieces[kept] = p;
+                        kept += 1;
+                        stops.history_ends.push(ends);
+                    }
+                    stops.pieces.truncate(kept);
                     for same in stops.pieces[first..].chunk_by(|p, q| p.key == q.key) {
                         stops.per_key = stops.per_key.max(same.len());
                     }
@@ -675,7 +721,8 @@ impl<'e> FirstDetections<'e> {
 }
 
 /// One sensor's stops: every (step, cell) of its reach with the pieces of
-/// its look there, and what the history detected up to their ends.
+/// its look there that the history did not detect for certain, and what
+/// the history detected up to their ends.
 #[derive(Debug)]
 struct Stops {
     /// The sensor's start, which offsets are from.

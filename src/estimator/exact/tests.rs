@@ -1,5 +1,6 @@
 //! The seen sets along rays, checked against the estimator's values.
 
+use super::first::Profile;
 use super::rays::{SourceRays, look_key};
 use super::seen::{RayHits, Sweep};
 use super::{ExactEstimator, Precomputed, Situation};
@@ -657,6 +658,64 @@ fn detected_upto_is_the_detected_length_up_to_a_point() {
                 "ray {m} of {} intervals at {x}: {got} against {want}",
                 lengths[m]
             );
+        }
+    }
+}
+
+/// `Profile::ends_unless_detected` is `None` exactly when the union of the
+/// certain pieces, merged where they touch, holds `[a, b]`, and otherwise
+/// the detected length up to both ends: on random pieces with ends on a
+/// grid of halves (so that touching is exact), with gaps, touching runs,
+/// uncertain pieces inside runs, points on the pieces' ends and outside
+/// every piece.
+#[test]
+fn a_profile_leaves_out_an_interval_inside_its_certain_runs() {
+    use rand::{RngExt, SeedableRng, rngs::StdRng};
+    let mut rng = StdRng::seed_from_u64(5);
+    let mut profile = Profile::default();
+    let mut keys = Vec::new();
+    for _ in 0..200 {
+        let mut pieces = Vec::new();
+        let mut x = f64::from(rng.random_range(-4..4)) * 0.5;
+        for _ in 0..rng.random_range(0..6) {
+            x += f64::from(rng.random_range(0..2)) * 0.5;
+            let end = x + f64::from(rng.random_range(1..4)) * 0.5;
+            let d = if rng.random_range(0..4) == 0 {
+                0.5
+            } else {
+                1.0
+            };
+            pieces.push((x, end, d));
+            x = end;
+        }
+        profile.push_key(pieces.iter().copied());
+        keys.push(pieces);
+    }
+    for (i, pieces) in keys.iter().enumerate() {
+        // The certain runs: certain pieces merged where one ends at the
+        // next one's start.
+        let mut runs: Vec<(f64, f64)> = Vec::new();
+        for &(x0, x1, _) in pieces.iter().filter(|p| p.2 == 1.0) {
+            match runs.last_mut() {
+                Some(run) if run.1 == x0 => run.1 = x1,
+                _ => runs.push((x0, x1)),
+            }
+        }
+        for _ in 0..50 {
+            let a = f64::from(rng.random_range(-10..14)) * 0.25;
+            let b = a + f64::from(rng.random_range(1..8)) * 0.25;
+            let upto = |x: f64| -> f64 {
+                (pieces.iter())
+                    .map(|&(x0, x1, d)| (x1.min(x) - x0).max(0.0) * d)
+                    .sum()
+            };
+            let want = if runs.iter().any(|&(x0, x1)| x0 <= a && b <= x1) {
+                None
+            } else {
+                Some((upto(a), upto(b)))
+            };
+            let got = profile.ends_unless_detected(i, a, b);
+            assert_eq!(got, want, "key {i} {pieces:?}, [{a}, {b}]");
         }
     }
 }
