@@ -140,6 +140,26 @@ fn first_detections_follow_their_searches() {
     assert_eq!(first_terms(&campus, &drones, 0.0).sighted, 0.0);
 }
 
+/// A first-detections search walks fewer pieces behind a longer history
+/// of certain looks (its stops leave out what that history detected), and
+/// as many behind uncertain looks as behind none.
+#[test]
+fn first_detections_searches_shrink_behind_a_certain_history() {
+    let terms = |p: &Planner, history: usize| {
+        let mut req = request(&p.scenario, 10, 3, 30, history);
+        req.objective = Some(Objective::FirstDetections);
+        let input = PlanInput::new(&p.scenario, &req).expect("valid");
+        first_terms(p, &input, 0.0)
+    };
+    let paper = Planner::new(builtins().remove(0));
+    let pairs = [16, 4, 1, 0].map(|h| terms(&paper, h).pairs);
+    increasing("pair gains by shorter certain histories", pairs);
+    assert!(pairs[0] < 0.7 * pairs[3], "{pairs:?}");
+    // `site-campus` looks detect with probability 0.9.
+    let campus = Planner::new(builtins().remove(4));
+    assert_eq!(terms(&campus, 16), terms(&campus, 0));
+}
+
 fn increasing(what: &str, costs: impl IntoIterator<Item = f64>) {
     let costs: Vec<f64> = costs.into_iter().collect();
     assert!(costs.windows(2).all(|w| w[1] > w[0]), "{what}: {costs:?}");
