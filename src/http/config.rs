@@ -172,10 +172,11 @@ pub struct Settings {
     pub session_cache_bytes: usize,
     /// Most bytes of sessions' carries held by this replica.
     pub session_carry_bytes: usize,
-    /// Whether plans predicted under [`INLINE_PLAN_MS`] run on the async
-    /// worker that received them instead of on rayon's pool; `None`: when
-    /// the pool has one thread (one core), where the hop to it and back is
-    /// two thread switches of pure cost.
+    /// Whether plans of detections predicted under [`INLINE_PLAN_MS`] run
+    /// on the async worker that received them instead of on rayon's pool;
+    /// `None`: when the pool has one thread (one core), where the hop to it
+    /// and back is two thread switches of pure cost. (A first-detections
+    /// plan would make that hop for each batch of its parallel searches.)
     pub inline_plans: Option<bool>,
 }
 

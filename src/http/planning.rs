@@ -14,6 +14,7 @@ use super::middleware::RequestStart;
 use super::state::AppState;
 use crate::cancel::{CancelToken, Progress};
 use crate::catalog::{CatalogError, precompute_cancellable};
+use crate::coordination::Objective;
 use crate::cost;
 use crate::estimator::Carry;
 use crate::metric_names;
@@ -95,8 +96,8 @@ pub(super) fn refuse_if_costly(state: &AppState, predicted_ms: f64) -> Result<()
 
 /// Validates `req`, refuses it if its predicted cost is above the limit,
 /// and plans it once admitted to the planning queue: on rayon, cancelled as
-/// soon as nobody waits for it, or (a short plan on a server that plans
-/// inline) on this async worker.
+/// soon as nobody waits for it, or (a short plan of detections on a
+/// server that plans inline) on this async worker.
 pub(super) async fn plan_admitted(
     state: &AppState,
     start: Option<Extension<RequestStart>>,
@@ -133,7 +134,12 @@ async fn plan_admitted_with(
     refuse_if_costly(state, predicted_ms)?;
     let guard = CancelOnDrop::new("plan", start, state);
     let token = guard.token();
-    let inline = state.settings.plans_inline() && predicted_ms <= INLINE_PLAN_MS;
+    // First detections run their searches in parallel batches, each of
+    // which a plan on this worker would hand to the pool and wait for: on
+    // the pool, the whole plan is one hop.
+    let inline = state.settings.plans_inline()
+        && predicted_ms <= INLINE_PLAN_MS
+        && input.objective == Objective::Detections;
     let work = move || match carry {
         Some(mut carry) => planner
             .plan_carried(&input, &token, &mut carry)

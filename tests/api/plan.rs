@@ -312,6 +312,21 @@ async fn plans_on_the_async_worker_answer_as_on_the_pool() {
     json_body(worker.plan(&long).await, StatusCode::OK).await;
     assert_eq!(on_worker().await, n);
 
+    // So does a first-detections plan predicted below it: its searches'
+    // parallel batches would each hop to the pool from the worker.
+    let mut first = plan_request();
+    first["objective"] = json!("first_detections");
+    let input = vigil::planner::PlanInput::new(
+        &planner.scenario,
+        &serde_json::from_value(first.clone()).unwrap(),
+    )
+    .unwrap();
+    assert!(vigil::cost::plan_ms(&planner, &input) <= INLINE_PLAN_MS);
+    let a = json_body(pool.plan(&first).await, StatusCode::OK).await;
+    let b = json_body(worker.plan(&first).await, StatusCode::OK).await;
+    assert_eq!(untimed(a), untimed(b));
+    assert_eq!(on_worker().await, n);
+
     // A session's steps alike.
     let mut ids = Vec::new();
     for app in [&pool, &worker] {
