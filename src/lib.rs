@@ -35,6 +35,7 @@ pub mod geometry;
 pub mod http;
 mod json_path;
 pub mod limits;
+pub mod memory;
 pub mod metric_names;
 pub mod obstacle;
 mod parallel;

@@ -34,6 +34,12 @@ const DATABASE_WAIT: Duration = Duration::from_secs(30);
 #[tokio::main]
 async fn main() -> ExitCode {
     let config = Config::parse();
+    // Before the work allocates: memory touched earlier keeps its pages.
+    let pages = if config.huge_pages {
+        Ok(())
+    } else {
+        vigil::memory::disable_huge_pages()
+    };
     let filter = EnvFilter::try_from_default_env().unwrap_or_else(|_| EnvFilter::new("info"));
     let logs = tracing_subscriber::fmt()
         .with_env_filter(filter)
@@ -41,6 +47,10 @@ async fn main() -> ExitCode {
     match config.log_format {
         LogFormat::Json => logs.json().init(),
         LogFormat::Human => logs.with_ansi(std::io::stderr().is_terminal()).init(),
+    }
+
+    if let Err(e) = pages {
+        tracing::warn!(error = %e, "cannot turn transparent huge pages off; running with the system's pages");
     }
 
     let started = Instant::now();

@@ -120,6 +120,12 @@ pub struct Config {
     /// step starts over.
     #[arg(long, env = "VIGIL_SESSION_CARRY_MB", default_value_t = (Settings::DEFAULT.session_carry_bytes >> 20) as u64)]
     pub session_carry_mb: u64,
+    /// Lets the kernel back this process's memory with transparent huge
+    /// pages as the system allows. Off by default: the first plans of a
+    /// process, and loading a stored precomputation, then wait for each
+    /// 2 MiB page to be zeroed (see `vigil::memory`).
+    #[arg(long, env = "VIGIL_HUGE_PAGES")]
+    pub huge_pages: bool,
 }
 
 impl Config {

@@ -372,3 +372,23 @@ async fn registering_a_large_scenario_does_not_stall_plans() {
         "the plan waited for the registration to finish"
     );
 }
+
+/// `THP_enabled` of process `pid` (`/proc/PID/status`): 0 once the process
+/// turned transparent huge pages off for itself.
+fn thp_enabled(pid: &str) -> String {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).expect("/proc/PID/status");
+    let line = status.lines().find_map(|l| l.strip_prefix("THP_enabled:"));
+    line.expect("a THP_enabled line").trim().to_owned()
+}
+
+#[test]
+fn the_server_turns_huge_pages_off_unless_asked() {
+    let dir = temp_dir("huge-pages");
+    let server = Server::start(&dir);
+    assert_eq!(thp_enabled(&server.child.id().to_string()), "0");
+    drop(server);
+    // With the flag it keeps what it inherited, as this process has it.
+    let server = Server::start_with(&dir, &["--huge-pages"]);
+    let inherited = thp_enabled("self");
+    assert_eq!(thp_enabled(&server.child.id().to_string()), inherited);
+}
