@@ -7,36 +7,8 @@
 use std::time::{Duration, Instant};
 
 use reqwest::StatusCode;
-use serde_json::{Value, json};
 
-use crate::helpers::{Server, cpu_after, cpu_seconds, temp_dir, wait_busy};
-
-/// A plan on `paper-v10` that runs for seconds: 256 sensors, horizon 12,
-/// iterated coordination, 4 000 targets and 8 steps of history.
-fn heavy_plan() -> Value {
-    let sensors: Vec<Value> = (0..256)
-        .map(|i| json!({"id": i, "x": 5.0 + (i % 16) as f64 * 18.0, "y": 5.0 + (i / 16) as f64 * 18.0}))
-        .collect();
-    let targets: Vec<Value> = (0..4000)
-        .map(|i| {
-            let f = i as f64;
-            json!({"x": (f * 7.3) % 300.0, "y": (f * 13.7) % 300.0, "vx": (f % 7.0) - 3.0, "vy": (f % 5.0) - 2.0})
-        })
-        .collect();
-    let history: Vec<Value> = (1..=8)
-        .map(|s| {
-            let step: Vec<Value> = (0..256)
-                .map(|i| {
-                    json!({"x": (5.0 + (i % 16) as f64 * 18.0 + s as f64) % 300.0,
-                           "y": 5.0 + (i / 16) as f64 * 18.0})
-                })
-                .collect();
-            json!(step)
-        })
-        .collect();
-    json!({"sensors": sensors, "targets": targets, "history": history, "horizon": 12,
-           "coordination": "iterated"})
-}
+use crate::helpers::{Server, cpu_after, cpu_seconds, heavy_plan, temp_dir, wait_busy};
 
 async fn cancelled_count(address: &str, reason: &str) -> f64 {
     crate::helpers::metric(

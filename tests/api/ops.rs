@@ -9,7 +9,9 @@ use reqwest::{StatusCode, header};
 use serde_json::{Value, json};
 use vigil::http::config::Settings;
 
-use crate::helpers::{Server, assert_problem, spawn_with, temp_dir};
+use crate::helpers::{
+    Server, assert_problem, cpu_seconds, heavy_plan, spawn_with, temp_dir, wait_busy,
+};
 
 /// A plan request that keeps a core busy for a while: many sensors, a long
 /// horizon, iterated coordination.
@@ -297,17 +299,19 @@ async fn sigterm_finishes_the_plan_in_flight_then_exits_0() {
     let dir = temp_dir("shutdown");
     let mut server = Server::start_with(&dir, &["--max-plan-ms", "0"]);
     let url = format!("{}/v1/scenarios/paper-v10/plan", server.address);
-    // The most sensors allowed: a plan that takes well over the delay below.
-    let sensors: Vec<Value> = (0..256)
-        .map(|i| json!({"id": i, "x": 3 + (i % 16) * 18, "y": 3 + (i / 16) * 18}))
-        .collect();
-    let body = json!({"sensors": sensors, "horizon": 12, "coordination": "iterated"});
+    // A plan of seconds, well over the delay below.
+    let body = heavy_plan();
+    let idle = cpu_seconds(server.child.id());
     let started = std::time::Instant::now();
     let in_flight = tokio::spawn(async move {
         let res = reqwest::Client::new().post(url).json(&body).send().await;
         (res, started.elapsed())
     });
-    tokio::time::sleep(Duration::from_millis(150)).await;
+    // Signalled once the plan runs (its request read whole).
+    let child = server.child.id();
+    tokio::task::spawn_blocking(move || wait_busy(child, idle, 0.2))
+        .await
+        .unwrap();
     let pid = server.child.id().to_string();
     let signalled = started.elapsed();
     let killed = Command::new(kill).args(["-TERM", &pid]).status().unwrap();
