@@ -200,7 +200,7 @@ impl<'a> Fleet<'a> {
     pub fn by_step(&self, paths: &[&[Cell]], order: &[usize]) -> Vec<f64> {
         let s = self.scenario;
         if let Some(first) = self.first {
-            return first.by_step(&self.all_looks(paths, order));
+            return first.by_step_on(paths, order, self.horizon);
         }
         (1..=self.horizon)
             .map(|t| {
@@ -250,18 +250,6 @@ pub fn first_search_budget(horizon: usize) -> usize {
 }
 
 impl Fleet<'_> {
-    /// Every look of `sensors` on `paths`, per step 1..=T.
-    pub fn all_looks(&self, paths: &[&[Cell]], sensors: &[usize]) -> Vec<Vec<Look>> {
-        (1..=self.horizon)
-            .map(|t| {
-                sensors
-                    .iter()
-                    .map(|&q| self.scenario.look(self.types[q], paths[q][t - 1]))
-                    .collect()
-            })
-            .collect()
-    }
-
     /// Sensor `i`'s best path for first detections against the looks of
     /// `sensors` on `paths` (at every step: a target another sensor
     /// detects at step 1 is not there to detect at step 3), around

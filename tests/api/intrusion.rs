@@ -15,8 +15,25 @@ fn total(v: &Value) -> f64 {
 #[tokio::test]
 async fn first_detection_plans_score_their_value_and_stay_within_their_bound() {
     let app = spawn_app().await;
-    for coordination in ["none", "priority", "iterated", "joint"] {
+    // Plans leave out of their values the pieces a certain history
+    // detected (their searches never build them); evaluate builds every
+    // piece: the values agree step by step, with and without a history.
+    let history = json!([
+        [{"x": 55.0, "y": 45.0}, {"x": 150.0, "y": 140.0}, {"x": 235.0, "y": 60.0}],
+        [{"x": 55.0, "y": 35.0}, {"x": 150.0, "y": 130.0}, {"x": 225.0, "y": 60.0}]
+    ]);
+    for (coordination, with_history) in [
+        ("none", false),
+        ("priority", false),
+        ("iterated", false),
+        ("joint", false),
+        ("priority", true),
+        ("iterated", true),
+    ] {
         let mut req = plan_request();
+        if with_history {
+            req["history"] = history.clone();
+        }
         req["coordination"] = json!(coordination);
         req["objective"] = json!("first_detections");
         let plan = json_body(app.plan(&req).await, StatusCode::OK).await;
@@ -46,6 +63,18 @@ async fn first_detection_plans_score_their_value_and_stay_within_their_bound() {
             total(&scored),
             total(&plan)
         );
+        let steps = |v: &Value| -> Vec<f64> {
+            let steps = v["expected_by_step"].as_array().unwrap();
+            steps.iter().map(|x| x.as_f64().unwrap()).collect()
+        };
+        let (planned, evaluated) = (steps(&plan), steps(&scored));
+        assert_eq!(planned.len(), evaluated.len());
+        for (p, e) in planned.iter().zip(&evaluated) {
+            assert!(
+                (p - e).abs() <= 1e-9 * total(&plan),
+                "{coordination}: {planned:?} vs {evaluated:?}"
+            );
+        }
         ev["objective"] = json!("detections");
         let as_detections = json_body(
             app.post_json("/v1/scenarios/paper-v10/evaluate", &ev).await,

@@ -112,10 +112,12 @@ impl Profile {
         (&self.ends[lo..hi], &self.known[lo..hi])
     }
 
-    /// `∫_{−∞}^x detected` over the `i`-th key's pieces.
-    fn upto(&self, i: usize, x: f64) -> f64 {
+    /// `∫_{−∞}^a` and `∫_{−∞}^b` of what the `i`-th key's pieces detect,
+    /// for `a ≤ b`: `b`'s piece is looked for only past `a`'s.
+    pub(super) fn upto_pair(&self, i: usize, a: f64, b: f64) -> (f64, f64) {
         let (ends, known) = self.key(i);
-        upto_from(ends, known, first_ending_after(ends, x), x)
+        let j = first_ending_after(ends, a);
+        (upto_from(ends, known, j, a), upto_after(ends, known, j, b))
     }
 
     /// `∫_{−∞}^a` and `∫_{−∞}^b` of what the `i`-th key's pieces detect,
@@ -135,8 +137,14 @@ impl Profile {
                 return None;
             }
         }
-        Some((upto_from(ends, known, j, a), self.upto(i, b)))
+        Some((upto_from(ends, known, j, a), upto_after(ends, known, j, b)))
     }
+}
+
+/// `∫_{−∞}^x detected` over a key's pieces, none of whose first `j` ends
+/// after `x`.
+fn upto_after(ends: &[f64], known: &[Known], j: usize, x: f64) -> f64 {
+    upto_from(ends, known, j + first_ending_after(&ends[j..], x), x)
 }
 
 /// The first of a key's pieces that ends after `x` (their ends are
@@ -336,9 +344,7 @@ impl<'e> FirstDetections<'e> {
     /// taken at step `t`), per step: the targets not yet detected that some
     /// look of step `t` detects and no look of an earlier step did.
     pub fn by_step(&self, looks: &[Vec<Look>]) -> Vec<f64> {
-        let horizon = looks.len();
         let mut buf = PieceScratch::default();
-        // (step, piece), sorted by key then step.
         let mut all: Vec<(usize, Piece)> = Vec::new();
         let mut one = Vec::new();
         for (t, step) in looks.iter().enumerate() {
@@ -348,6 +354,29 @@ impl<'e> FirstDetections<'e> {
                 all.extend(one.iter().map(|&p| (t + 1, p)));
             }
         }
+        self.first_by_step(all, looks.len())
+    }
+
+    /// [`FirstDetections::by_step`] of the looks of `sensors` on `paths`
+    /// (`paths[q][t − 1]` at step `t`, for `t` in 1..=`horizon`), read
+    /// from the sensors' stops where their searches built them: a piece
+    /// they leave out, which the history detected for certain, detects no
+    /// target first (the values agree to rounding).
+    pub fn by_step_on(&self, paths: &[&[Cell]], sensors: &[usize], horizon: usize) -> Vec<f64> {
+        let (pieces, step_ends) = self.pieces_by_step(paths, sensors, horizon);
+        let mut all: Vec<(usize, Piece)> = Vec::with_capacity(pieces.len());
+        let mut from = 0;
+        for (t, &end) in (1..).zip(&step_ends) {
+            all.extend(pieces[from..end].iter().map(|&p| (t, p)));
+            from = end;
+        }
+        self.first_by_step(all, horizon)
+    }
+
+    /// The first detections per step of `all`, (step, piece) pairs over
+    /// `horizon` steps.
+    fn first_by_step(&self, mut all: Vec<(usize, Piece)>, horizon: usize) -> Vec<f64> {
+        // Sorted by key then step.
         all.sort_by(|x, y| x.1.key.cmp(&y.1.key).then(x.0.cmp(&y.0)));
         let mut by_step = vec![0.0; horizon];
         let mut intervals: Vec<(f64, f64, f64)> = Vec::new();
@@ -406,9 +435,20 @@ impl<'e> FirstDetections<'e> {
     /// stops where its search built them (which leave out the pieces the
     /// history detected for certain: a background detects them already).
     fn pieces_on(&self, paths: &[&[Cell]], sensors: &[usize], horizon: usize) -> Vec<Piece> {
+        self.pieces_by_step(paths, sensors, horizon).0
+    }
+
+    /// [`FirstDetections::pieces_on`], and where each step's pieces end.
+    fn pieces_by_step(
+        &self,
+        paths: &[&[Cell]],
+        sensors: &[usize],
+        horizon: usize,
+    ) -> (Vec<Piece>, Vec<usize>) {
         let s = self.est.scenario;
         let mut buf = PieceScratch::default();
         let mut pieces = Vec::new();
+        let mut step_ends = Vec::with_capacity(horizon);
         for t in 1..=horizon {
             for &q in sensors {
                 let cell = paths[q][t - 1];
@@ -417,8 +457,9 @@ impl<'e> FirstDetections<'e> {
                     None => self.pieces(&s.look(self.est.types[q], cell), t, &mut pieces, &mut buf),
                 }
             }
+            step_ends.push(pieces.len());
         }
-        pieces
+        (pieces, step_ends)
     }
 
     /// The pieces of sensor `q`'s look at `cell` at step `t` that the
@@ -693,10 +734,7 @@ impl<'e> FirstDetections<'e> {
             .zip(&stops.history_ends)
             .map(|(p, &history)| match overlay[p.key as usize] {
                 u32::MAX => history,
-                i => (
-                    background.merged.upto(i as usize, p.a),
-                    background.merged.upto(i as usize, p.b),
-                ),
+                i => background.merged.upto_pair(i as usize, p.a, p.b),
             })
             .collect();
         let alone: Vec<f64> = stops

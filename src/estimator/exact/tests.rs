@@ -667,7 +667,9 @@ fn detected_upto_is_the_detected_length_up_to_a_point() {
 /// the detected length up to both ends: on random pieces with ends on a
 /// grid of halves (so that touching is exact), with gaps, touching runs,
 /// uncertain pieces inside runs, points on the pieces' ends and outside
-/// every piece.
+/// every piece; keys of a few pieces and of more than `SCAN_PIECES` (whose
+/// ends are bisected, not counted). `Profile::upto_pair` is the detected
+/// length up to both ends, always.
 #[test]
 fn a_profile_leaves_out_an_interval_inside_its_certain_runs() {
     use rand::{RngExt, SeedableRng, rngs::StdRng};
@@ -677,7 +679,12 @@ fn a_profile_leaves_out_an_interval_inside_its_certain_runs() {
     for _ in 0..200 {
         let mut pieces = Vec::new();
         let mut x = f64::from(rng.random_range(-4..4)) * 0.5;
-        for _ in 0..rng.random_range(0..6) {
+        let count = if rng.random_range(0..4) == 0 {
+            rng.random_range(33..80)
+        } else {
+            rng.random_range(0..6)
+        };
+        for _ in 0..count {
             x += f64::from(rng.random_range(0..2)) * 0.5;
             let end = x + f64::from(rng.random_range(1..4)) * 0.5;
             let d = if rng.random_range(0..4) == 0 {
@@ -701,9 +708,14 @@ fn a_profile_leaves_out_an_interval_inside_its_certain_runs() {
                 _ => runs.push((x0, x1)),
             }
         }
+        let (lo, hi) = pieces
+            .first()
+            .zip(pieces.last())
+            .map_or((0.0, 0.0), |(f, l)| (f.0, l.1));
         for _ in 0..50 {
-            let a = f64::from(rng.random_range(-10..14)) * 0.25;
-            let b = a + f64::from(rng.random_range(1..8)) * 0.25;
+            let a = lo - 2.0 + f64::from(rng.random_range(0..=4 * (hi - lo + 4.0) as i32)) * 0.25;
+            let b =
+                a + f64::from(rng.random_range(1..8)) * 0.25 * f64::from(rng.random_range(1..4));
             let upto = |x: f64| -> f64 {
                 (pieces.iter())
                     .map(|&(x0, x1, d)| (x1.min(x) - x0).max(0.0) * d)
@@ -716,6 +728,8 @@ fn a_profile_leaves_out_an_interval_inside_its_certain_runs() {
             };
             let got = profile.ends_unless_detected(i, a, b);
             assert_eq!(got, want, "key {i} {pieces:?}, [{a}, {b}]");
+            let pair = profile.upto_pair(i, a, b);
+            assert_eq!(pair, (upto(a), upto(b)), "key {i} {pieces:?}, [{a}, {b}]");
         }
     }
 }
