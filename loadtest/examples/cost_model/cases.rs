@@ -825,6 +825,26 @@ pub fn first_cases(b: &mut Builder) {
         let r = first(&b.requests(pv10, &w, 1)[0], 3, Coordination::Priority);
         b.plan(Group::First, format!("first sensors {n}"), pv10, r);
     }
+    let r = set(&first(r0, 3, Coordination::Priority), |r| {
+        r.observed = Some(Observed::Zone)
+    });
+    b.plan(Group::First, "first observed zone".into(), pv10, r);
+    for n in [1usize, 4] {
+        let w = Workload {
+            sensors: n,
+            ..reference()
+        };
+        let r = set(
+            &first(&b.requests(pv10, &w, 1)[0], 3, Coordination::Priority),
+            |r| r.observed = Some(Observed::Zone),
+        );
+        b.plan(
+            Group::First,
+            format!("first observed zone, sensors {n}"),
+            pv10,
+            r,
+        );
+    }
     let gates = b.planner(builtins().remove(2));
     let r = first(
         &b.requests(gates, &reference(), 1)[0],
