@@ -53,7 +53,7 @@ struct Piece {
 pub(super) struct Profile {
     /// `ends[start[i]..start[i + 1]]` belong to the `i`-th key listed.
     start: Vec<u32>,
-    /// Each piece's end `x1`, apart so that [`Profile::upto`]'s search
+    /// Each piece's end `x1`, apart so that [`first_ending_after`]'s search
     /// reads only them.
     ends: Vec<f64>,
     /// Aligned with `ends`: the rest of each piece, together so that the
@@ -70,7 +70,7 @@ struct Known {
     before: f64,
 }
 
-/// Pieces of a key up to which [`Profile::upto`] counts the ends before
+/// Pieces of a key up to which [`first_ending_after`] counts the ends before
 /// its point instead of bisecting them: a count is a scan without
 /// branches, a bisection a chain of dependent loads and mispredictions.
 const SCAN_PIECES: usize = 32;
@@ -116,8 +116,7 @@ impl Profile {
     /// for `a ≤ b`: `b`'s piece is looked for only past `a`'s.
     pub(super) fn upto_pair(&self, i: usize, a: f64, b: f64) -> (f64, f64) {
         let (ends, known) = self.key(i);
-        let j = first_ending_after(ends, a);
-        (upto_from(ends, known, j, a), upto_after(ends, known, j, b))
+        upto_pair_from(ends, known, first_ending_after(ends, a), a, b)
     }
 
     /// `∫_{−∞}^a` and `∫_{−∞}^b` of what the `i`-th key's pieces detect,
@@ -137,14 +136,15 @@ impl Profile {
                 return None;
             }
         }
-        Some((upto_from(ends, known, j, a), upto_after(ends, known, j, b)))
+        Some(upto_pair_from(ends, known, j, a, b))
     }
 }
 
-/// `∫_{−∞}^x detected` over a key's pieces, none of whose first `j` ends
-/// after `x`.
-fn upto_after(ends: &[f64], known: &[Known], j: usize, x: f64) -> f64 {
-    upto_from(ends, known, j + first_ending_after(&ends[j..], x), x)
+/// `∫_{−∞}^a` and `∫_{−∞}^b` over a key's pieces, `j` the first that ends
+/// after `a ≤ b`: `b`'s piece is looked for only from it on.
+fn upto_pair_from(ends: &[f64], known: &[Known], j: usize, a: f64, b: f64) -> (f64, f64) {
+    let k = j + first_ending_after(&ends[j..], b);
+    (upto_from(ends, known, j, a), upto_from(ends, known, k, b))
 }
 
 /// The first of a key's pieces that ends after `x` (their ends are
