@@ -12,6 +12,11 @@ fn total(v: &Value) -> f64 {
     v["expected_detections"].as_f64().unwrap()
 }
 
+fn by_step(v: &Value) -> Vec<f64> {
+    let steps = v["expected_by_step"].as_array().unwrap();
+    steps.iter().map(|x| x.as_f64().unwrap()).collect()
+}
+
 #[tokio::test]
 async fn first_detection_plans_score_their_value_and_stay_within_their_bound() {
     let app = spawn_app().await;
@@ -38,13 +43,8 @@ async fn first_detection_plans_score_their_value_and_stay_within_their_bound() {
         req["objective"] = json!("first_detections");
         let plan = json_body(app.plan(&req).await, StatusCode::OK).await;
         assert_eq!(plan["objective"], "first_detections");
-        let by_step: f64 = plan["expected_by_step"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|v| v.as_f64().unwrap())
-            .sum();
-        assert!(close(by_step, total(&plan), 1e-12));
+        let planned = by_step(&plan);
+        assert!(close(planned.iter().sum(), total(&plan), 1e-12));
         let upper = plan["bound"]["upper"].as_f64().unwrap();
         assert!(total(&plan) > 0.0 && total(&plan) <= upper + 1e-9);
         // Each target counts once: never more than the detections objective
@@ -63,11 +63,7 @@ async fn first_detection_plans_score_their_value_and_stay_within_their_bound() {
             total(&scored),
             total(&plan)
         );
-        let steps = |v: &Value| -> Vec<f64> {
-            let steps = v["expected_by_step"].as_array().unwrap();
-            steps.iter().map(|x| x.as_f64().unwrap()).collect()
-        };
-        let (planned, evaluated) = (steps(&plan), steps(&scored));
+        let evaluated = by_step(&scored);
         assert_eq!(planned.len(), evaluated.len());
         for (p, e) in planned.iter().zip(&evaluated) {
             assert!(
