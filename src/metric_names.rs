@@ -46,6 +46,10 @@ pub const SESSION_CARRY_BYTES: &str = "vigil_session_carry_bytes";
 /// started over) or `none` (the carry does not apply: uncertain looks,
 /// buildings, the paper's estimator).
 pub const SESSION_STEPS_TOTAL: &str = "vigil_session_steps_total";
+/// Counter of sessions' steps written to the database, by `when`:
+/// `during_plan` (begun while the plan was made, committed after it) or
+/// `after_plan`.
+pub const SESSION_WRITES_TOTAL: &str = "vigil_session_writes_total";
 
 /// Counter of registered scenarios' precomputations, by `outcome`
 /// (`loaded`: read from the database; `computed`: precomputed here under a
@@ -54,7 +58,7 @@ pub const SESSION_STEPS_TOTAL: &str = "vigil_session_steps_total";
 pub const PRECOMPUTED_TOTAL: &str = "vigil_precomputed_total";
 
 /// Every metric above.
-pub const ALL: [&str; 19] = [
+pub const ALL: [&str; 20] = [
     HTTP_REQUESTS_TOTAL,
     HTTP_REQUESTS_IN_FLIGHT,
     HTTP_SHED_TOTAL,
@@ -73,6 +77,7 @@ pub const ALL: [&str; 19] = [
     SESSIONS_EVICTED_TOTAL,
     SESSION_CARRY_BYTES,
     SESSION_STEPS_TOTAL,
+    SESSION_WRITES_TOTAL,
     PRECOMPUTED_TOTAL,
 ];
 

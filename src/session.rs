@@ -585,23 +585,50 @@ impl Session {
 
     /// Step 5 of the module docs: records a step whose plan was made.
     pub fn commit(&mut self, prepared: PreparedStep) {
-        if self.history_len > 0 {
-            let looks = prepared
-                .request
-                .sensors
-                .iter()
-                .map(|s| PositionIn {
-                    x: s.x,
-                    y: s.y,
-                    sensor_type: s.sensor_type.clone(),
-                })
-                .collect();
-            self.history.push_front(looks);
-            self.history.truncate(self.history_len);
-        }
+        remember(&mut self.history, self.history_len, &prepared);
         self.tracks = prepared.tracks;
         self.step += 1;
     }
+
+    /// The snapshot of this session once `prepared` is committed
+    /// ([`Session::commit`]), the session unchanged, so that it can be
+    /// stored while the step's plan is made. `None` for a session that
+    /// learns rates: its step also commits what its fold learnt.
+    pub fn snapshot_after(&self, prepared: &PreparedStep) -> Option<Snapshot> {
+        if self.learner.is_some() {
+            return None;
+        }
+        let mut history = self.history.clone();
+        remember(&mut history, self.history_len, prepared);
+        Some(Snapshot {
+            settings: self.settings.clone(),
+            history_len: self.history_len,
+            step: self.step + 1,
+            history,
+            tracks: prepared.tracks.clone(),
+            learner: None,
+        })
+    }
+}
+
+/// Puts the sensors' positions of step `prepared` first in `history`, which
+/// keeps `len` steps.
+fn remember(history: &mut VecDeque<Vec<PositionIn>>, len: usize, prepared: &PreparedStep) {
+    if len == 0 {
+        return;
+    }
+    let looks = prepared
+        .request
+        .sensors
+        .iter()
+        .map(|s| PositionIn {
+            x: s.x,
+            y: s.y,
+            sensor_type: s.sensor_type.clone(),
+        })
+        .collect();
+    history.push_front(looks);
+    history.truncate(len);
 }
 
 #[cfg(test)]
@@ -714,6 +741,25 @@ mod tests {
         assert_eq!(e.field, "detections[0].y");
         req.detections = vec![anonymous(1.0, 1.0, 0.0); MAX_TARGETS + 1];
         assert_eq!(req.check().unwrap_err().field, "detections");
+    }
+
+    /// What a step stores while its plan is made is what committing it
+    /// leaves, history full or not, and for no history at all.
+    #[test]
+    fn a_snapshot_after_a_step_is_the_committed_one() {
+        for history in [0, 2] {
+            let mut s = session(history);
+            for k in 0..4u32 {
+                let x = 50.0 + f64::from(k) * 7.0;
+                let prepared = s.prepare(&step(vec![anonymous(x, 30.0, 1.5)]));
+                let after = s
+                    .snapshot_after(&prepared)
+                    .expect("a session that does not learn");
+                assert_eq!(s.step(), u64::from(k), "unchanged until committed");
+                s.commit(prepared);
+                assert_eq!(after, s.snapshot());
+            }
+        }
     }
 
     #[test]

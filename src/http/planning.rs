@@ -94,6 +94,48 @@ pub(super) fn refuse_if_costly(state: &AppState, predicted_ms: f64) -> Result<()
     Ok(())
 }
 
+/// A plan request validated, its predicted cost within the server's limit
+/// ([`admit`]).
+pub(super) struct Admitted {
+    input: PlanInput,
+    /// Its predicted CPU time, ms ([`cost::plan_ms`]).
+    pub(super) predicted_ms: f64,
+    /// Whether a short plan may run on the async worker.
+    may_inline: bool,
+}
+
+impl Admitted {
+    /// The same plan, made on the pool however short, so that this async
+    /// worker stays free for I/O that runs beside it.
+    pub(super) fn on_pool(self) -> Self {
+        Self {
+            may_inline: false,
+            ..self
+        }
+    }
+}
+
+/// Validates `req` on `planner` and refuses it if its predicted cost is
+/// above the limit, before any of its work starts.
+///
+/// # Errors
+/// The request's [`crate::scenario::ValidationError`];
+/// [`ApiError::PlanTooCostly`] (see [`refuse_if_costly`]).
+pub(super) fn admit(
+    state: &AppState,
+    planner: &Planner,
+    req: &PlanRequest,
+) -> Result<Admitted, ApiError> {
+    let input = PlanInput::new(&planner.scenario, req)?;
+    let predicted_ms = cost::plan_ms(planner, &input);
+    refuse_if_costly(state, predicted_ms)?;
+    Ok(Admitted {
+        input,
+        predicted_ms,
+        may_inline: true,
+    })
+}
+
 /// Validates `req`, refuses it if its predicted cost is above the limit,
 /// and plans it once admitted to the planning queue: on rayon, cancelled as
 /// soon as nobody waits for it, or (a short plan of detections on a
@@ -104,40 +146,44 @@ pub(super) async fn plan_admitted(
     planner: Arc<Planner>,
     req: &PlanRequest,
 ) -> Result<PlanResponse, ApiError> {
-    let (plan, _) = plan_admitted_with(state, start, planner, req, None).await?;
+    let admitted = admit(state, &planner, req)?;
+    let (plan, _) = plan_with(state, start, planner, admitted, None).await?;
     Ok(plan)
 }
 
-/// [`plan_admitted`] for a session's step, from and into the session's
-/// `carry` ([`Planner::plan_carried`]), which comes back with the plan (a
-/// step that fails drops it).
+/// [`plan_admitted`] of a session's step, already [`admit`]ted, from and
+/// into the session's `carry` ([`Planner::plan_carried`]), which comes
+/// back with the plan (a step that fails drops it).
 pub(super) async fn plan_admitted_carried(
     state: &AppState,
     start: Option<Extension<RequestStart>>,
     planner: Arc<Planner>,
-    req: &PlanRequest,
+    admitted: Admitted,
     carry: Carry,
 ) -> Result<(PlanResponse, Carry), ApiError> {
-    let (plan, carry) = plan_admitted_with(state, start, planner, req, Some(carry)).await?;
+    let (plan, carry) = plan_with(state, start, planner, admitted, Some(carry)).await?;
     Ok((plan, carry.unwrap_or_default()))
 }
 
-async fn plan_admitted_with(
+async fn plan_with(
     state: &AppState,
     start: Option<Extension<RequestStart>>,
     planner: Arc<Planner>,
-    req: &PlanRequest,
+    admitted: Admitted,
     carry: Option<Carry>,
 ) -> Result<(PlanResponse, Option<Carry>), ApiError> {
-    let input = PlanInput::new(&planner.scenario, req)?;
-    let predicted_ms = cost::plan_ms(&planner, &input);
-    refuse_if_costly(state, predicted_ms)?;
+    let Admitted {
+        input,
+        predicted_ms,
+        may_inline,
+    } = admitted;
     let guard = CancelOnDrop::new("plan", start, state);
     let token = guard.token();
     // First detections run their searches in parallel batches, each of
     // which a plan on this worker would hand to the pool and wait for: on
     // the pool, the whole plan is one hop.
-    let inline = state.settings.plans_inline()
+    let inline = may_inline
+        && state.settings.plans_inline()
         && predicted_ms <= INLINE_PLAN_MS
         && input.objective == Objective::Detections;
     let work = move || match carry {

@@ -6,11 +6,13 @@
 //!   every replica serves every session. This replica's memory holds only
 //!   a cache of sessions it served, bounded in bytes. A step is
 //!   acknowledged only once stored over the version it was made from
-//!   ([`SessionStore::save`]). It is made from the cached state, one round
-//!   trip to the database in all, while no other replica moves the session
-//!   on; once one did (the store failed), each step first checks the
-//!   cached state against the row's version and reloads it if needed, until
-//!   a check finds nobody moved it.
+//!   ([`SessionStore::save`]). It is made from the cached state, with no
+//!   read, while no other replica moves the session on; once one did (the
+//!   store failed), each step first checks the cached state against the
+//!   row's version and reloads it if needed, until a check finds nobody
+//!   moved it. A short step without an Idempotency-Key writes its new state
+//!   while its plan is made and commits it once the plan is
+//!   ([`SessionStore::save_early`]), so that only the commit waits for it.
 //!
 //! Either way a step answered for an `Idempotency-Key` is answered again,
 //! unchanged, to a retry with that key and the same body
@@ -27,9 +29,9 @@ use super::carries::Carries;
 use super::error::ApiError;
 use crate::metric_names;
 use crate::planner::Planner;
-use crate::session::{Session, Snapshot};
-use crate::store::PgStore;
-use crate::store::sessions::NewSession;
+use crate::session::{PreparedStep, Session, Snapshot};
+use crate::store::sessions::{NewSession, StepWrite};
+use crate::store::{DbError, PgStore};
 
 /// What every session id starts with; 32 hexadecimal digits follow.
 const SESSION_ID_PREFIX: &str = "ss-";
@@ -68,11 +70,22 @@ pub struct Held {
 /// What a step or a read finds ([`SessionStore::refresh`]).
 #[derive(Debug)]
 pub enum Refreshed<'a> {
-    /// The session, current.
-    Session(&'a mut Session),
+    /// The session, current, and the stored version it is at.
+    Session(&'a mut Session, Base),
     /// The answer already given to this Idempotency-Key.
     Replay(Bytes),
 }
+
+/// The stored version of a refreshed session's state: what a step made
+/// from it is stored over ([`SessionStore::save_early`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Base(i64);
+
+/// Plans predicted to take longer than this, ms, are stored once made
+/// rather than while they are made ([`SessionStore::save_early`]): the
+/// early write holds a pooled connection and its row's lock until its plan
+/// ends.
+const SAVE_EARLY_MAX_MS: f64 = 100.0;
 
 /// A step's `Idempotency-Key` and its request's digest
 /// ([`crate::session::StepRequest::digest`]): a retry has both of the step
@@ -362,7 +375,7 @@ impl SessionStore {
                 return replay(key, Some(digest), answer.clone());
             }
             return match &mut held.session {
-                Some(session) => Ok(Refreshed::Session(session)),
+                Some(session) => Ok(Refreshed::Session(session, Base(held.version))),
                 None => Err(self.not_found(id)),
             };
         };
@@ -425,7 +438,7 @@ impl SessionStore {
         held.version = row.version;
         held.stale = false;
         match &mut held.session {
-            Some(session) => Ok(Refreshed::Session(session)),
+            Some(session) => Ok(Refreshed::Session(session, Base(held.version))),
             None => Err(ApiError::Internal(format!("session {id} was not loaded"))),
         }
     }
@@ -450,15 +463,13 @@ impl SessionStore {
         let Some(session) = &held.session else {
             return Err(ApiError::Internal(format!("session {id} was not loaded")));
         };
-        let bytes = session.memory_bytes();
         let Some(db) = &self.db else {
-            held.last = key.map(|k| (k.key.to_owned(), k.digest, answer.clone()));
-            self.resize(id, bytes + answer.len());
-            return Ok(true);
+            return Ok(self.record(id, held, true, key, answer));
         };
         // Until it is known to be stored, this state is not the stored one.
         held.stale = true;
         let state = session.snapshot().encode();
+        metrics::counter!(metric_names::SESSION_WRITES_TOTAL, "when" => "after_plan").increment(1);
         let stored = db
             .save_session(
                 id,
@@ -470,15 +481,85 @@ impl SessionStore {
                 answer,
             )
             .await?;
-        if stored {
+        Ok(self.record(id, held, stored, key, answer))
+    }
+
+    /// Begins storing step `prepared` of `session` (refreshed at `base`)
+    /// while its plan is made, when that saves time: in the database, for a
+    /// step without an Idempotency-Key (whose answer would be one more
+    /// write after the plan), of a session that does not learn, its plan
+    /// predicted to take at most [`SAVE_EARLY_MAX_MS`], with a connection
+    /// free. Else `None`: store it with [`SessionStore::save`] once made.
+    /// The write is seen by nobody until [`SessionStore::finish_early`]
+    /// commits it; dropped, it is rolled back.
+    pub fn save_early<'s>(
+        &'s self,
+        id: &'s str,
+        base: Base,
+        session: &Session,
+        prepared: &PreparedStep,
+        predicted_ms: f64,
+        key: Option<StepKey<'_>>,
+    ) -> Option<impl Future<Output = Result<Option<StepWrite>, DbError>> + 's> {
+        let db = self.db.as_ref().filter(|db| {
+            key.is_none() && predicted_ms <= SAVE_EARLY_MAX_MS && db.has_free_connection()
+        })?;
+        let state = session.snapshot_after(prepared)?.encode();
+        let ttl = self.ttl;
+        metrics::counter!(metric_names::SESSION_WRITES_TOTAL, "when" => "during_plan").increment(1);
+        Some(async move {
+            db.begin_step(id, ttl, base.0, Snapshot::FORMAT, &state)
+                .await
+        })
+    }
+
+    /// [`SessionStore::save`] for a step whose write `written` began with
+    /// [`SessionStore::save_early`]: commits it.
+    ///
+    /// # Errors
+    /// As [`SessionStore::save`].
+    pub async fn finish_early(
+        &self,
+        id: &str,
+        held: &mut Held,
+        written: Result<Option<StepWrite>, DbError>,
+        answer: &Bytes,
+    ) -> Result<bool, ApiError> {
+        let Some(db) = &self.db else {
+            return Err(ApiError::Internal(format!("session {id}: no database")));
+        };
+        held.stale = true;
+        let stored = match written? {
+            Some(write) => {
+                write.commit(db).await?;
+                true
+            }
+            None => false,
+        };
+        Ok(self.record(id, held, stored, None, answer))
+    }
+
+    /// Notes in `held` whether its step, answered `answer`, was `stored`.
+    fn record(
+        &self,
+        id: &str,
+        held: &mut Held,
+        stored: bool,
+        key: Option<StepKey<'_>>,
+        answer: &Bytes,
+    ) -> bool {
+        if !stored {
+            held.shared = true;
+            return false;
+        }
+        if self.db.is_some() {
             held.version += 1;
             held.stale = false;
-            held.last = key.map(|k| (k.key.to_owned(), k.digest, answer.clone()));
-            self.resize(id, bytes + answer.len());
-        } else {
-            held.shared = true;
         }
-        Ok(stored)
+        held.last = key.map(|k| (k.key.to_owned(), k.digest, answer.clone()));
+        let bytes = held.session.as_ref().map_or(0, Session::memory_bytes);
+        self.resize(id, bytes + answer.len());
+        true
     }
 
     /// Marks session `id` (from [`SessionStore::checkout`]) used now, as

@@ -22,15 +22,15 @@ use super::doc::{self, examples};
 use super::error::ApiError;
 use super::extract::{Json, Path, QueuedJson};
 use super::middleware::RequestStart;
-use super::planning::{plan_admitted_carried, resolve_scenario};
+use super::planning::{Admitted, admit, plan_admitted_carried, resolve_scenario};
 use super::session_store::{Refreshed, StepKey};
 use super::state::AppState;
-use crate::fit::SourceRate;
+use crate::fit::{LearntStep, SourceRate};
 use crate::limits::{MAX_HORIZON, MAX_IDEMPOTENCY_KEY_CHARS, MAX_MIN_SEPARATION, MAX_TARGETS};
 use crate::metric_names;
 use crate::planner::{PlanResponse, Planner, check_estimator};
 use crate::scenario::{ScenarioSpec, ValidationError};
-use crate::session::{Session, SessionSettings, StepRequest, Track};
+use crate::session::{PreparedStep, Session, SessionSettings, StepRequest, Track};
 
 /// A session, as `POST /v1/sessions` and `GET /v1/sessions/{id}` return it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, ToSchema)]
@@ -254,22 +254,58 @@ pub async fn step(
     let mut held = shared.lock().await;
     for _ in 0..STEP_ATTEMPTS {
         let resolve = async |scenario_id, spec| stored_planner(&state, scenario_id, spec).await;
-        let session = match state
+        let (session, base) = match state
             .sessions
             .refresh(&id, &mut held, key, false, resolve)
             .await?
         {
             Refreshed::Replay(answer) => return Ok(json_bytes(answer)),
-            Refreshed::Session(session) => session,
+            Refreshed::Session(session, base) => (session, base),
         };
-        let answer = match make_step(&state, start, &id, session, &req).await {
-            Ok(answer) => answer,
+        let mut ready = match prepare_step(&state, session, &req).await {
+            Ok(ready) => ready,
             Err(e) => {
                 state.sessions.touch(&id);
                 return Err(e);
             }
         };
-        if state.sessions.save(&id, &mut held, key, &answer).await? {
+        // In the database, the new state is written while the plan is made
+        // and committed once it is (rolled back if it fails).
+        let early = state.sessions.save_early(
+            &id,
+            base,
+            session,
+            &ready.prepared,
+            ready.admitted.predicted_ms,
+            key,
+        );
+        let (answer, written) = match early {
+            Some(write) => {
+                ready.admitted = ready.admitted.on_pool();
+                let (answer, written) =
+                    tokio::join!(make_step(&state, start, &id, session, ready), write);
+                (answer, Some(written))
+            }
+            None => (make_step(&state, start, &id, session, ready).await, None),
+        };
+        let answer = match answer {
+            Ok(answer) => answer,
+            Err(e) => {
+                drop(written);
+                state.sessions.touch(&id);
+                return Err(e);
+            }
+        };
+        let stored = match written {
+            Some(written) => {
+                state
+                    .sessions
+                    .finish_early(&id, &mut held, written, &answer)
+                    .await?
+            }
+            None => state.sessions.save(&id, &mut held, key, &answer).await?,
+        };
+        if stored {
             return Ok(json_bytes(answer));
         }
     }
@@ -308,15 +344,21 @@ fn idempotency_key(headers: &HeaderMap) -> Result<Option<&str>, ApiError> {
     Ok(Some(key))
 }
 
-/// Makes one step on `session` (changed only if its plan is made) and
-/// returns its answer, encoded.
-async fn make_step(
+/// A step of a session, prepared and admitted, its plan not yet made.
+struct ReadyStep {
+    prepared: PreparedStep,
+    learnt: Option<LearntStep>,
+    planner: Arc<Planner>,
+    admitted: Admitted,
+}
+
+/// Prepares a step of `session` (unchanged): its stateless request, this
+/// step's fold for a session that learns rates, and the plan's admission.
+async fn prepare_step(
     state: &AppState,
-    start: Option<Extension<RequestStart>>,
-    id: &str,
-    session: &mut Session,
+    session: &Session,
     req: &StepRequest,
-) -> Result<Bytes, ApiError> {
+) -> Result<ReadyStep, ApiError> {
     let prepared = session.prepare(req);
     if prepared.request.targets.len() > MAX_TARGETS {
         return Err(ValidationError::new(
@@ -339,9 +381,32 @@ async fn make_step(
         None => None,
     };
     let planner = session.planner_for(learnt.as_ref());
+    let admitted = admit(state, &planner, &prepared.request)?;
+    Ok(ReadyStep {
+        prepared,
+        learnt,
+        planner,
+        admitted,
+    })
+}
+
+/// Makes step `ready` on `session` (changed only if its plan is made) and
+/// returns its answer, encoded.
+async fn make_step(
+    state: &AppState,
+    start: Option<Extension<RequestStart>>,
+    id: &str,
+    session: &mut Session,
+    ready: ReadyStep,
+) -> Result<Bytes, ApiError> {
+    let ReadyStep {
+        prepared,
+        learnt,
+        planner,
+        admitted,
+    } = ready;
     let carry = state.carries.take(id);
-    let (plan, carry) =
-        plan_admitted_carried(state, start, planner, &prepared.request, carry).await?;
+    let (plan, carry) = plan_admitted_carried(state, start, planner, admitted, carry).await?;
     metrics::counter!(metric_names::SESSION_STEPS_TOTAL, "carry" => carry.last_use().as_str())
         .increment(1);
     state.carries.keep(id, carry);
@@ -425,7 +490,7 @@ pub async fn get(
         .refresh(&id, &mut held, None, true, resolve)
         .await?
     {
-        Refreshed::Session(session) => Ok(Json(SessionInfo::of(id, session))),
+        Refreshed::Session(session, _) => Ok(Json(SessionInfo::of(id, session))),
         Refreshed::Replay(_) => Err(ApiError::Internal("a read replayed a step".into())),
     }
 }

@@ -160,6 +160,12 @@ impl PgStore {
         metrics::gauge!(metric_names::DATABASE_UP).set(if up { 1.0 } else { 0.0 });
     }
 
+    /// Whether the pool has a connection free, or room to open one: a
+    /// call now would not wait for another to end.
+    pub fn has_free_connection(&self) -> bool {
+        self.pool.num_idle() > 0 || self.pool.size() < POOL_SIZE
+    }
+
     /// Runs `call` within the timeout (a short one while the database is
     /// known to be down, so requests that need it fail fast) and records
     /// whether the database answered.

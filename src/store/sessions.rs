@@ -7,7 +7,10 @@
 //!   only if the row is still at `v`, so two replicas stepping one session
 //!   at once never both succeed, and the loser makes its step again from
 //!   the winner's state. A single `UPDATE` in autocommit: once it returns,
-//!   the step is durable.
+//!   the step is durable. Or the same `UPDATE` in a transaction begun
+//!   while the step's plan is made ([`PgStore::begin_step`]), committed
+//!   once it is: the row's lock makes a step of another replica wait for
+//!   the commit, then find the row moved on.
 //! - **Idle time and count.** A row not used for the time to live is
 //!   expired: every query treats it as absent, and creations delete the
 //!   expired rows. A creation past the count deletes the least recently
@@ -65,6 +68,23 @@ pub struct NewSession<'a> {
     pub format: i32,
     /// Its snapshot.
     pub state: &'a [u8],
+}
+
+/// A step written by [`PgStore::begin_step`], not yet committed.
+#[derive(Debug)]
+pub struct StepWrite {
+    tx: sqlx::Transaction<'static, sqlx::Postgres>,
+}
+
+impl StepWrite {
+    /// Stores the step for good: once this returns, it is durable.
+    ///
+    /// # Errors
+    /// [`DbError`] if the database is unreachable or too slow (the step
+    /// may then have been stored or not).
+    pub async fn commit(self, store: &PgStore) -> Result<(), DbError> {
+        store.bounded(self.tx.commit()).await
+    }
 }
 
 /// The expiry condition on a row, its time to live in seconds being `$2`.
@@ -238,7 +258,44 @@ impl PgStore {
         Ok(done.rows_affected() == 1)
     }
 
-    /// Marks session `id` used now; false if it is not live.
+    /// Begins storing a step of session `id` made from version `base`, one
+    /// without an Idempotency-Key, as [`PgStore::save_session`] does but in
+    /// a transaction left open, so that the write runs while the step's
+    /// plan is made: the row is then locked at `base + 1`, and nobody sees
+    /// the step until [`StepWrite::commit`] (dropping the [`StepWrite`]
+    /// rolls it back). `None` if the row moved on from `base`, expired or
+    /// is gone.
+    ///
+    /// # Errors
+    /// [`DbError`] if the database is unreachable or too slow.
+    pub async fn begin_step(
+        &self,
+        id: &str,
+        ttl: Duration,
+        base: i64,
+        format: i32,
+        state: &[u8],
+    ) -> Result<Option<StepWrite>, DbError> {
+        self.bounded(async {
+            let mut tx = self.pool.begin().await?;
+            let done = sqlx::query(&format!(
+                "UPDATE sessions SET version = version + 1, format = $4, state = $5, \
+                 last_key = NULL, last_response = NULL, digest_key = NULL, last_digest = NULL, \
+                 last_used = now() WHERE id = $1 AND {LIVE} AND version = $3"
+            ))
+            .bind(id)
+            .bind(ttl.as_secs_f64())
+            .bind(base)
+            .bind(format)
+            .bind(state)
+            .execute(&mut *tx)
+            .await?;
+            Ok((done.rows_affected() == 1).then_some(StepWrite { tx }))
+        })
+        .await
+    }
+
+    /// Marks session `id` used now; false if it is not live.    /// Marks session `id` used now; false if it is not live.
     ///
     /// # Errors
     /// [`DbError`] if the database is unreachable or too slow.

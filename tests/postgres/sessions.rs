@@ -162,6 +162,65 @@ pub async fn learning_sessions_across_replicas(cluster: Arc<Cluster>) {
     assert!(scenarios.len() >= 3, "{scenarios:?}");
 }
 
+/// A step whose client goes away while its plan is made, its new state
+/// being written meanwhile (`vigil_session_writes_total{when="during_plan"}`),
+/// is not stored: both replicas read the session at the step before, and
+/// the next step follows that one.
+pub async fn a_dropped_step_is_not_stored(cluster: Arc<Cluster>) {
+    let url = cluster.database("sessions_dropped").await;
+    let a = Server::start("a", &url, &[]);
+    let b = Server::start("b", &url, &[]);
+    let id = open(
+        &a,
+        &json!({"scenario_id": "paper-v10", "horizon": 12, "coordination": "iterated"}),
+    )
+    .await;
+    let first = json!({"sensors": [{"id": "s0", "x": 20.0, "y": 20.0}], "horizon": 2});
+    let (status, v) = body(a.post(&format!("/v1/sessions/{id}/step"), &first).await).await;
+    assert_eq!((status, &v["step"]), (StatusCode::OK, &json!(0)), "{v}");
+    // Tens of milliseconds of plan (80 sensors, T = 12): the client waits
+    // 10 of them.
+    let sensors: Vec<Value> = (0..80)
+        .map(|i| json!({"id": format!("s{i}"), "x": 10 + (i * 37) % 280, "y": 10 + (i * 53) % 280}))
+        .collect();
+    let impatient = reqwest::Client::builder()
+        .timeout(Duration::from_millis(10))
+        .build()
+        .unwrap();
+    let sent = impatient
+        .post(format!("{}/v1/sessions/{id}/step", a.address))
+        .json(&json!({"sensors": sensors}))
+        .send()
+        .await;
+    assert!(sent.is_err(), "answered within 10 ms: {sent:?}");
+    let until = Instant::now() + Duration::from_secs(10);
+    while a
+        .metric_with("vigil_cancelled_total", "client_gone")
+        .await
+        .unwrap_or(0.0)
+        < 1.0
+    {
+        assert!(Instant::now() < until, "the plan was not cancelled");
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+    let early = a
+        .metric_with("vigil_session_writes_total", "during_plan")
+        .await;
+    assert_eq!(early, Some(2.0), "both steps wrote during their plans");
+    for server in [&a, &b] {
+        let (status, info) = body(server.get(&format!("/v1/sessions/{id}")).await).await;
+        assert_eq!(
+            (status, &info["step"]),
+            (StatusCode::OK, &json!(1)),
+            "{info}"
+        );
+    }
+    let (status, v) = body(b.post(&format!("/v1/sessions/{id}/step"), &first).await).await;
+    assert_eq!((status, &v["step"]), (StatusCode::OK, &json!(1)), "{v}");
+    let (status, v) = body(a.post(&format!("/v1/sessions/{id}/step"), &first).await).await;
+    assert_eq!((status, &v["step"]), (StatusCode::OK, &json!(2)), "{v}");
+}
+
 /// Steps sent at once through two replicas: each answered one is made
 /// from the one before (distinct, consecutive step numbers), the others
 /// are refused with 409, and the session counts exactly the answered.

@@ -42,6 +42,9 @@ pub const ALL: &[(&str, Test)] = &[
     ("learning_sessions_across_replicas", |c| {
         Box::pin(sessions::learning_sessions_across_replicas(c))
     }),
+    ("a_dropped_step_is_not_stored", |c| {
+        Box::pin(sessions::a_dropped_step_is_not_stored(c))
+    }),
     ("concurrent_steps_are_serialised", |c| {
         Box::pin(sessions::concurrent_steps_are_serialised(c))
     }),
