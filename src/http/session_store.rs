@@ -489,9 +489,10 @@ impl SessionStore {
     /// step without an Idempotency-Key (whose answer would be one more
     /// write after the plan), of a session that does not learn, its plan
     /// predicted to take at most [`SAVE_EARLY_MAX_MS`], with a connection
-    /// free. Else `None`: store it with [`SessionStore::save`] once made.
-    /// The write is seen by nobody until [`SessionStore::finish_early`]
-    /// commits it; dropped, it is rolled back.
+    /// to spare ([`PgStore::has_spare_connection`]). Else `None`: store it
+    /// with [`SessionStore::save`] once made. The write is seen by nobody
+    /// until [`SessionStore::finish_early`] commits it; dropped, it is
+    /// rolled back.
     pub fn save_early<'s>(
         &'s self,
         id: &'s str,
@@ -502,7 +503,7 @@ impl SessionStore {
         key: Option<StepKey<'_>>,
     ) -> Option<impl Future<Output = Result<Option<StepWrite>, DbError>> + 's> {
         let db = self.db.as_ref().filter(|db| {
-            key.is_none() && predicted_ms <= SAVE_EARLY_MAX_MS && db.has_free_connection()
+            key.is_none() && predicted_ms <= SAVE_EARLY_MAX_MS && db.has_spare_connection()
         })?;
         let state = session.snapshot_after(prepared)?.encode();
         let ttl = self.ttl;

@@ -160,10 +160,12 @@ impl PgStore {
         metrics::gauge!(metric_names::DATABASE_UP).set(if up { 1.0 } else { 0.0 });
     }
 
-    /// Whether the pool has a connection free, or room to open one: a
-    /// call now would not wait for another to end.
-    pub fn has_free_connection(&self) -> bool {
-        self.pool.num_idle() > 0 || self.pool.size() < POOL_SIZE
+    /// Whether the pool has two connections free (idle, or room to open
+    /// them): one for a call that holds its connection for a while (a
+    /// step's write during its plan), one left for the calls that do not.
+    pub fn has_spare_connection(&self) -> bool {
+        let room = POOL_SIZE.saturating_sub(self.pool.size()) as usize;
+        self.pool.num_idle() + room >= 2
     }
 
     /// Runs `call` within the timeout (a short one while the database is
