@@ -62,7 +62,7 @@ impl Planner {
     }
 
     /// [`Planner::new`], in blocks of cells (see
-    /// [`Stats::for_fov_cancellable`]) that check `cancel` and advance
+    /// [`Stats::for_slot_cancellable`]) that check `cancel` and advance
     /// `progress`; the indexing of rays that follows is one more block.
     /// The planner is the same as [`Planner::new`]'s.
     ///

@@ -710,11 +710,11 @@ impl RayHits {
 }
 
 /// The sweep that cuts one ray's weighted intervals into pieces of one
-/// detection probability each, as [`detection_pieces`] does: starts and
-/// ends are sorted apart, by the bits of their distance (never negative,
-/// so the bits sort as the numbers do), which is about twice as fast as
-/// sorting both together by a float comparison; at one distance the ends
-/// come first. Its buffers are kept from ray to ray.
+/// detection probability each, as [`crate::geometry::detection_pieces`]
+/// does: starts and ends are sorted apart, by the bits of their distance
+/// (never negative, so the bits sort as the numbers do), which is about
+/// twice as fast as sorting both together by a float comparison; at one
+/// distance the ends come first. Its buffers are kept from ray to ray.
 #[derive(Default)]
 pub(super) struct Sweep {
     starts: Vec<(u64, f64)>,

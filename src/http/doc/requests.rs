@@ -14,9 +14,9 @@ use crate::evaluate::SensorPathIn;
 use crate::planner::{EstimatorKind, Observed, PositionIn, SensorIn, TargetIn};
 use crate::scenario::{Integer, ScenarioSpec};
 
-/// The fields of `POST /v1/scenarios/{id}/plan`'s body ([`PlanRequest`]
-/// for the schema) with one more, required: the two shapes of the body of
-/// `POST /v1/plan`.
+/// The fields of `POST /v1/scenarios/{id}/plan`'s body
+/// ([`crate::planner::PlanRequest`] for the schema) with one more,
+/// required: the two shapes of the body of `POST /v1/plan`.
 macro_rules! plan_request_with {
     ($(#[$doc:meta])* $name:ident, $($(#[$field_doc:meta])* $field:ident: $ty:ty),+ $(,)?) => {
         $(#[$doc])*
