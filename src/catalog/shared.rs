@@ -20,7 +20,7 @@ use crate::metric_names;
 use crate::planner::{PRECOMPUTED_FORMAT, Planner};
 use crate::scenario::Scenario;
 use crate::store::PgStore;
-use crate::store::precomputed::Stored;
+use crate::store::precomputed::{Stored, unpack};
 
 /// How often a replica waiting for another's precomputation looks for it.
 const WAIT_POLL: Duration = Duration::from_millis(250);
@@ -33,43 +33,48 @@ fn count(outcome: &'static str) {
 
 /// The stored precomputation of `scenario`, if there is one that this
 /// build reads (one that it does not is deleted, so it is stored again).
+/// Its chunks are decompressed as they are read ([`unpack`]).
 pub(super) async fn load(store: &PgStore, scenario: &Scenario) -> Option<Planner> {
     let id = scenario.id.clone();
     let started = Instant::now();
-    let stored = match store.load_precomputed(&id).await {
-        Ok(Some(stored)) => stored,
-        Ok(None) => return None,
+    let (to, parts) = std::sync::mpsc::channel();
+    let unpacking = tokio::task::spawn_blocking(move || unpack(&parts));
+    let sent = store.send_precomputed(&id, &to).await;
+    drop(to);
+    let unpacked = unpacking
+        .await
+        .unwrap_or_else(|e| Err(format!("unpacking failed: {e}")));
+    match sent {
+        Ok(true) => {}
+        Ok(false) => return None,
         Err(e) => {
             tracing::warn!(%id, error = %e, "cannot read a stored precomputation");
             return None;
         }
-    };
-    let compressed = stored.compressed_bytes();
-    let fetch_ms = started.elapsed().as_secs_f64() * 1e3;
+    }
+    let read_ms = started.elapsed().as_secs_f64() * 1e3;
     let scenario = scenario.clone();
     let decoded = tokio::task::spawn_blocking(move || {
-        if stored.format != PRECOMPUTED_FORMAT as i32 {
+        let unpacked = unpacked?;
+        if unpacked.format != PRECOMPUTED_FORMAT as i32 {
             return Err(format!(
                 "format {}, this server reads {PRECOMPUTED_FORMAT}",
-                stored.format
+                unpacked.format
             ));
         }
-        let unpacking = Instant::now();
-        let raw = stored.decompress()?;
-        let unpack_ms = unpacking.elapsed().as_secs_f64() * 1e3;
-        let planner = Planner::from_precomputed(scenario, &raw).map_err(|e| e.to_string())?;
+        let planner =
+            Planner::from_precomputed(scenario, &unpacked.raw).map_err(|e| e.to_string())?;
         tracing::debug!(
-            unpack_ms,
             decode_ms = planner.precompute_ms,
             "decoded a stored precomputation"
         );
-        Ok(planner)
+        Ok((planner, unpacked.compressed_bytes))
     })
     .await
     .unwrap_or_else(|e| Err(format!("decoding failed: {e}")));
     match decoded {
-        Ok(planner) => {
-            tracing::info!(%id, compressed, fetch_ms, load_ms = started.elapsed().as_secs_f64() * 1e3, "loaded a stored precomputation");
+        Ok((planner, compressed)) => {
+            tracing::info!(%id, compressed, read_ms, load_ms = started.elapsed().as_secs_f64() * 1e3, "loaded a stored precomputation");
             count("loaded");
             Some(planner)
         }
