@@ -70,6 +70,55 @@ pub struct NewSession<'a> {
     pub state: &'a [u8],
 }
 
+/// The expiry condition on a row, its time to live in seconds being `$2`
+/// (a macro, so that constant statements can include it).
+macro_rules! live {
+    () => {
+        "last_used > now() - make_interval(secs => $2)"
+    };
+}
+
+/// [`live!`] for the statements built at run time.
+const LIVE: &str = live!();
+
+/// The compare-and-set that stores a step of session `id` made from
+/// version `base` ([`PgStore::save_session`], [`PgStore::begin_step`]).
+struct StepUpdate<'a> {
+    id: &'a str,
+    ttl: Duration,
+    base: i64,
+    format: i32,
+    state: &'a [u8],
+    /// The step's Idempotency-Key and request digest, if it had a key.
+    key: Option<(&'a str, &'a [u8])>,
+    /// Its answer, stored if it had a key.
+    response: &'a [u8],
+}
+
+/// [`StepUpdate`]'s statement.
+const STEP_UPDATE: &str = concat!(
+    "UPDATE sessions SET version = version + 1, format = $4, state = $5, ",
+    "last_key = $6, last_response = CASE WHEN $6 IS NULL THEN NULL ELSE $7 END, ",
+    "digest_key = $6, last_digest = $8, last_used = now() ",
+    "WHERE id = $1 AND ",
+    live!(),
+    " AND version = $3"
+);
+
+impl<'a> StepUpdate<'a> {
+    fn query(&self) -> sqlx::query::Query<'a, sqlx::Postgres, sqlx::postgres::PgArguments> {
+        sqlx::query(STEP_UPDATE)
+            .bind(self.id)
+            .bind(self.ttl.as_secs_f64())
+            .bind(self.base)
+            .bind(self.format)
+            .bind(self.state)
+            .bind(self.key.map(|(key, _)| key))
+            .bind(self.response)
+            .bind(self.key.map(|(_, digest)| digest))
+    }
+}
+
 /// A step written by [`PgStore::begin_step`], not yet committed.
 #[derive(Debug)]
 pub struct StepWrite {
@@ -86,9 +135,6 @@ impl StepWrite {
         store.bounded(self.tx.commit()).await
     }
 }
-
-/// The expiry condition on a row, its time to live in seconds being `$2`.
-const LIVE: &str = "last_used > now() - make_interval(secs => $2)";
 
 impl PgStore {
     /// Stores a new session, first deleting the expired rows and, past
@@ -236,25 +282,16 @@ impl PgStore {
         key: Option<(&str, &[u8])>,
         response: &[u8],
     ) -> Result<bool, DbError> {
-        let done = self
-            .bounded(
-                sqlx::query(&format!(
-                    "UPDATE sessions SET version = version + 1, format = $4, state = $5, \
-                     last_key = $6, last_response = CASE WHEN $6 IS NULL THEN NULL ELSE $7 END, \
-                     digest_key = $6, last_digest = $8, \
-                     last_used = now() WHERE id = $1 AND {LIVE} AND version = $3"
-                ))
-                .bind(id)
-                .bind(ttl.as_secs_f64())
-                .bind(base)
-                .bind(format)
-                .bind(state)
-                .bind(key.map(|(key, _)| key))
-                .bind(response)
-                .bind(key.map(|(_, digest)| digest))
-                .execute(&self.pool),
-            )
-            .await?;
+        let step = StepUpdate {
+            id,
+            ttl,
+            base,
+            format,
+            state,
+            key,
+            response,
+        };
+        let done = self.bounded(step.query().execute(&self.pool)).await?;
         Ok(done.rows_affected() == 1)
     }
 
@@ -276,26 +313,24 @@ impl PgStore {
         format: i32,
         state: &[u8],
     ) -> Result<Option<StepWrite>, DbError> {
+        let step = StepUpdate {
+            id,
+            ttl,
+            base,
+            format,
+            state,
+            key: None,
+            response: &[],
+        };
         self.bounded(async {
             let mut tx = self.pool.begin().await?;
-            let done = sqlx::query(&format!(
-                "UPDATE sessions SET version = version + 1, format = $4, state = $5, \
-                 last_key = NULL, last_response = NULL, digest_key = NULL, last_digest = NULL, \
-                 last_used = now() WHERE id = $1 AND {LIVE} AND version = $3"
-            ))
-            .bind(id)
-            .bind(ttl.as_secs_f64())
-            .bind(base)
-            .bind(format)
-            .bind(state)
-            .execute(&mut *tx)
-            .await?;
+            let done = step.query().execute(&mut *tx).await?;
             Ok((done.rows_affected() == 1).then_some(StepWrite { tx }))
         })
         .await
     }
 
-    /// Marks session `id` used now; false if it is not live.    /// Marks session `id` used now; false if it is not live.
+    /// Marks session `id` used now; false if it is not live.
     ///
     /// # Errors
     /// [`DbError`] if the database is unreachable or too slow.
