@@ -79,17 +79,6 @@ impl Stored {
         })
     }
 
-    /// Its parts as [`PgStore::send_precomputed`] sends them: the head,
-    /// then every chunk.
-    pub fn parts(&self) -> impl Iterator<Item = Part> + '_ {
-        let head = Part::Head {
-            format: self.format,
-            raw_bytes: self.raw_bytes,
-            chunks: self.chunks.len(),
-        };
-        std::iter::once(head).chain(self.chunks.iter().cloned().map(Part::Chunk))
-    }
-
     /// Its size compressed.
     pub fn compressed_bytes(&self) -> usize {
         self.chunks.iter().map(Vec::len).sum()
@@ -388,6 +377,19 @@ impl PgStore {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    impl Stored {
+        /// Its parts as [`PgStore::send_precomputed`] sends them: the
+        /// head, then every chunk.
+        fn parts(&self) -> impl Iterator<Item = Part> + '_ {
+            let head = Part::Head {
+                format: self.format,
+                raw_bytes: self.raw_bytes,
+                chunks: self.chunks.len(),
+            };
+            std::iter::once(head).chain(self.chunks.iter().cloned().map(Part::Chunk))
+        }
+    }
 
     fn stored_parts(raw: &[u8]) -> Vec<Part> {
         Stored::compress(1, raw).unwrap().parts().collect()
