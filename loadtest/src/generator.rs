@@ -219,6 +219,7 @@ pub async fn preflight(target: &Target, api_key: Option<&str>, timeout: Duration
             warmup: Vec::new(),
             steps: Vec::new(),
             sessions: 1,
+            idempotency_keys: t.idempotency_keys,
         });
         let slots = open_sessions(&client, &one, auth.as_ref(), timeout).await?;
         let first = t.warmup.first().or(t.steps.first()).cloned();
@@ -504,7 +505,8 @@ impl Worker {
                         lock(&recorder).session_wait.saturating_record(micros(w));
                     }
                     let url = &slot.step_urls[(k + step as usize) % slot.step_urls.len()];
-                    Some((slot, url, step, t.steps[body].clone()))
+                    let key = t.idempotency_keys.then(|| step.to_string());
+                    Some((slot, url, step, t.steps[body].clone(), key))
                 }
                 _ => None,
             };
@@ -514,7 +516,13 @@ impl Worker {
                 None
             } else {
                 let rb = match &slot {
-                    Some((_, url, _, body)) => post(&client, url, body.clone()),
+                    Some((_, url, _, body, key)) => {
+                        let rb = post(&client, url, body.clone());
+                        match key {
+                            Some(key) => rb.header("Idempotency-Key", key.as_str()),
+                            None => rb,
+                        }
+                    }
                     None => request(&client, &target, job.seq, None),
                 };
                 Some(
@@ -531,7 +539,7 @@ impl Worker {
                 )
             };
             let done = Instant::now();
-            if let Some((slot, _, step, _)) = &slot {
+            if let Some((slot, _, step, _, _)) = &slot {
                 slot.done.send_replace(step + 1);
             }
             let mut r = lock(&recorder);

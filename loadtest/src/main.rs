@@ -283,6 +283,11 @@ struct RunArgs {
     /// session i mod N, and waits for that session's previous step.
     #[arg(long, default_value_t = 32)]
     sessions: usize,
+    /// With `--endpoint session`: each step sends an `Idempotency-Key`
+    /// header (its step number, unique in its session), as the Python
+    /// client does, so that the server also keeps its answer for a retry.
+    #[arg(long)]
+    idempotency_keys: bool,
     /// Longest a request may take from its intended send time; past it, it
     /// counts as an error.
     #[arg(long, default_value = "5s", value_parser = parse_duration)]
@@ -608,6 +613,9 @@ fn run_cmd(a: &RunArgs) -> Result<()> {
     if !a.also_url.is_empty() && a.endpoint != Endpoint::Session {
         bail!("--also-url spreads the steps of sessions: it needs --endpoint session");
     }
+    if a.idempotency_keys && a.endpoint != Endpoint::Session {
+        bail!("--idempotency-keys names the steps of sessions: it needs --endpoint session");
+    }
     let target = match a.endpoint {
         Endpoint::Healthz => Target::healthz(&a.url),
         Endpoint::Plan => {
@@ -629,10 +637,9 @@ fn run_cmd(a: &RunArgs) -> Result<()> {
                 &a.url,
                 &a.also_url,
                 &a.workload.scenario,
-                &wl.settings,
-                &wl.warmup,
-                &wl.steps,
+                &wl,
                 a.sessions,
+                a.idempotency_keys,
             )?
         }
     };

@@ -10,7 +10,7 @@ use std::time::Duration;
 
 use axum::Router;
 use axum::extract::{Path, State};
-use axum::http::StatusCode;
+use axum::http::{HeaderMap, StatusCode};
 use axum::routing::{delete, post};
 use bytes::Bytes;
 use tokio::net::TcpListener;
@@ -31,6 +31,8 @@ struct Seen {
     deleted: AtomicU64,
     /// Per session: which listener served each step.
     served_by: Mutex<HashMap<String, Vec<usize>>>,
+    /// Per session: the `Idempotency-Key` of each step, if it had one.
+    keys: Mutex<HashMap<String, Vec<Option<String>>>>,
 }
 
 /// A server with the session routes: each step takes `service` plus a few
@@ -79,7 +81,19 @@ fn fake_app(seen: &Arc<Seen>, service: Duration, index: usize) -> Router {
         .route(
             "/v1/sessions/{id}/step",
             post(
-                move |State(seen): State<Arc<Seen>>, Path(id): Path<String>, body: String| async move {
+                move |State(seen): State<Arc<Seen>>,
+                      Path(id): Path<String>,
+                      headers: HeaderMap,
+                      body: String| async move {
+                    let key = headers
+                        .get("idempotency-key")
+                        .map(|v| v.to_str().expect("a text key").to_owned());
+                    seen.keys
+                        .lock()
+                        .expect("lock")
+                        .entry(id.clone())
+                        .or_default()
+                        .push(key);
                     let n = {
                         let mut map = seen.sessions.lock().expect("lock");
                         let Some((bodies, busy)) = map.get_mut(&id) else {
@@ -110,15 +124,17 @@ fn fake_app(seen: &Arc<Seen>, service: Duration, index: usize) -> Router {
         )
         .route(
             "/v1/sessions/{id}",
-            delete(|State(seen): State<Arc<Seen>>, Path(id): Path<String>| async move {
-                let gone = seen.sessions.lock().expect("lock").remove(&id).is_some();
-                seen.deleted.fetch_add(1, Ordering::SeqCst);
-                if gone {
-                    StatusCode::NO_CONTENT
-                } else {
-                    StatusCode::NOT_FOUND
-                }
-            }),
+            delete(
+                |State(seen): State<Arc<Seen>>, Path(id): Path<String>| async move {
+                    let gone = seen.sessions.lock().expect("lock").remove(&id).is_some();
+                    seen.deleted.fetch_add(1, Ordering::SeqCst);
+                    if gone {
+                        StatusCode::NO_CONTENT
+                    } else {
+                        StatusCode::NOT_FOUND
+                    }
+                },
+            ),
         )
         .with_state(Arc::clone(seen))
 }
@@ -129,6 +145,11 @@ fn target(base: &str, warmup: usize, steps: usize, sessions: usize) -> Target {
 
 /// Sessions opened through `bases[0]`, their steps spread over `bases`.
 fn replicated(bases: &[String], warmup: usize, steps: usize, sessions: usize) -> Target {
+    keyed(bases, warmup, steps, sessions, false)
+}
+
+/// [`replicated`], its timed steps with an `Idempotency-Key` if `keys`.
+fn keyed(bases: &[String], warmup: usize, steps: usize, sessions: usize, keys: bool) -> Target {
     let body = |s: String| Bytes::from(s);
     let base = &bases[0];
     Target::Session(Arc::new(SessionTarget {
@@ -139,6 +160,7 @@ fn replicated(bases: &[String], warmup: usize, steps: usize, sessions: usize) ->
         warmup: (0..warmup).map(|i| body(format!("w{i}"))).collect(),
         steps: (0..steps).map(|i| body(format!("s{i}"))).collect(),
         sessions,
+        idempotency_keys: keys,
     }))
 }
 
@@ -174,6 +196,29 @@ async fn a_sessions_steps_never_overlap_and_come_in_order() {
     // All closed.
     assert!(seen.sessions.lock().expect("lock").is_empty());
     assert!(!r.session_wait.is_empty(), "{}", r.describe());
+}
+
+/// With `idempotency_keys`, every timed step of a session names itself by
+/// a key of its own (a retry would reuse it), and the warm-up none;
+/// without, no step has one.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn timed_steps_carry_keys_of_their_own_when_asked() {
+    for keys in [true, false] {
+        let (base, seen) = fake_sessions(Duration::from_millis(1)).await;
+        let cfg = config(keyed(&[base], 2, 3, 2, keys), 100.0, 300, 4);
+        let r = run(&cfg).await.expect("run");
+        assert_eq!(r.summary.errors, 0, "{}", r.describe());
+        let sent = seen.keys.lock().expect("lock").clone();
+        assert_eq!(sent.len(), 2, "{sent:?}");
+        for steps in sent.values() {
+            let (warmup, timed) = steps.split_at(2);
+            assert!(warmup.iter().all(Option::is_none), "{steps:?}");
+            assert!(timed.len() >= 10, "{steps:?}");
+            let named: BTreeSet<&String> = timed.iter().flatten().collect();
+            let want = if keys { timed.len() } else { 0 };
+            assert_eq!(named.len(), want, "{steps:?}");
+        }
+    }
 }
 
 /// The order of the bodies each session received, read while the run is

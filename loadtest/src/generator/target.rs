@@ -5,7 +5,9 @@ use std::sync::Arc;
 
 use anyhow::{Result, bail};
 use bytes::Bytes;
-use vigil::session::{SessionSettings, StepRequest};
+use vigil::session::StepRequest;
+
+use crate::workload::SessionWorkload;
 
 /// What the requests hit.
 #[derive(Debug, Clone)]
@@ -47,6 +49,9 @@ pub struct SessionTarget {
     pub steps: Vec<Bytes>,
     /// Sessions open during the run.
     pub sessions: usize,
+    /// Whether each timed step sends an `Idempotency-Key` (its step
+    /// number, unique in its session), as the Python client does.
+    pub idempotency_keys: bool,
 }
 
 impl Target {
@@ -77,11 +82,15 @@ impl Target {
         base: &str,
         also: &[String],
         scenario: &str,
-        settings: &SessionSettings,
-        warmup: &[StepRequest],
-        steps: &[StepRequest],
+        workload: &SessionWorkload,
         sessions: usize,
+        idempotency_keys: bool,
     ) -> Result<Self> {
+        let SessionWorkload {
+            settings,
+            warmup,
+            steps,
+        } = workload;
         if steps.is_empty() {
             bail!("no session step to send");
         }
@@ -111,6 +120,7 @@ impl Target {
             warmup: bodies(warmup)?,
             steps: bodies(steps)?,
             sessions,
+            idempotency_keys,
         })))
     }
 
