@@ -25,6 +25,7 @@
 
 use super::ExactEstimator;
 use super::rays::{SourceRays, look_key};
+use std::borrow::Cow;
 use std::cell::RefCell;
 use std::sync::{Arc, Mutex, OnceLock};
 
@@ -569,6 +570,7 @@ impl<'e> FirstDetections<'e> {
                 start_of: vec![0],
                 pieces: Vec::new(),
                 history_ends: Vec::new(),
+                alone: Vec::new(),
                 per_key: 1,
             };
             let mut buf = PieceScratch::default();
@@ -642,6 +644,7 @@ impl<'e> FirstDetections<'e> {
                     stops.start_of.push(stops.pieces.len() as u32);
                 });
             }
+            stops.alone = gains_alone(&stops.pieces, &stops.history_ends);
             stops
         })
     }
@@ -722,27 +725,32 @@ impl<'e> FirstDetections<'e> {
         background: &Background,
         grid: &mut ValueGrid,
     ) -> PathCover<'s> {
-        // Which keys the extra looks touch: their ends move; the others'
-        // are the history's.
-        let mut overlay = vec![u32::MAX; self.history.start.len().saturating_sub(1)];
-        for (i, &key) in background.keys.iter().enumerate() {
-            overlay[key as usize] = i as u32;
-        }
-        let ends: Vec<(f64, f64)> = stops
-            .pieces
-            .iter()
-            .zip(&stops.history_ends)
-            .map(|(p, &history)| match overlay[p.key as usize] {
-                u32::MAX => history,
-                i => background.merged.upto_pair(i as usize, p.a, p.b),
-            })
-            .collect();
-        let alone: Vec<f64> = stops
-            .pieces
-            .iter()
-            .zip(&ends)
-            .map(|(p, &(ga, gb))| p.w * p.p * ((p.b - p.a) - (gb - ga)))
-            .collect();
+        let (ends, alone) = if background.keys.is_empty() {
+            // The history alone (a sensor's search by itself): the stops
+            // hold its ends and gains already.
+            (
+                Cow::Borrowed(&stops.history_ends[..]),
+                Cow::Borrowed(&stops.alone[..]),
+            )
+        } else {
+            // Which keys the extra looks touch: their ends move; the
+            // others' are the history's.
+            let mut overlay = vec![u32::MAX; self.history.start.len().saturating_sub(1)];
+            for (i, &key) in background.keys.iter().enumerate() {
+                overlay[key as usize] = i as u32;
+            }
+            let ends: Vec<(f64, f64)> = stops
+                .pieces
+                .iter()
+                .zip(&stops.history_ends)
+                .map(|(p, &history)| match overlay[p.key as usize] {
+                    u32::MAX => history,
+                    i => background.merged.upto_pair(i as usize, p.a, p.b),
+                })
+                .collect();
+            let alone = gains_alone(&stops.pieces, &ends);
+            (Cow::Owned(ends), Cow::Owned(alone))
+        };
         for t in 1..=grid.horizon() {
             grid.fill_step(t, |dc, dr| {
                 let i = stops.slots[stops.index(t, (dc, dr))];
@@ -756,6 +764,16 @@ impl<'e> FirstDetections<'e> {
             scratch: RefCell::default(),
         }
     }
+}
+
+/// Each piece's gain alone, `ends` being what the others detected up to
+/// its ends.
+fn gains_alone(pieces: &[Piece], ends: &[(f64, f64)]) -> Vec<f64> {
+    pieces
+        .iter()
+        .zip(ends)
+        .map(|(p, &(ga, gb))| p.w * p.p * ((p.b - p.a) - (gb - ga)))
+        .collect()
 }
 
 /// One sensor's stops: every (step, cell) of its reach with the pieces of
@@ -777,6 +795,8 @@ struct Stops {
     /// Aligned with `pieces`: `∫_{−∞}^a` and `∫_{−∞}^b` of what the history
     /// detected.
     history_ends: Vec<(f64, f64)>,
+    /// Aligned with `pieces`: each one's gain over the history alone.
+    alone: Vec<f64>,
     /// The most pieces one stop has on one key: 1 unless obstacles cut a
     /// look's view of a ray.
     per_key: usize,
@@ -822,9 +842,9 @@ pub struct PathCover<'s> {
     /// Aligned with the stops' pieces: what the background detected up to
     /// each one's ends (`∫_{−∞}^a` and `∫_{−∞}^b`), so that every integral
     /// over parts of pieces, whose ends are pieces' ends, is a difference.
-    ends: Vec<(f64, f64)>,
+    ends: Cow<'s, [(f64, f64)]>,
     /// Aligned with the stops' pieces: each one's gain alone.
-    alone: Vec<f64>,
+    alone: Cow<'s, [f64]>,
     /// Scratch space of the gains.
     scratch: RefCell<Sweep>,
 }
