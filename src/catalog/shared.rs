@@ -16,6 +16,7 @@ use tokio::runtime::Handle;
 
 use super::jobs::{Pool, precompute_on};
 use crate::cancel::{CancelToken, Cancelled, Progress};
+use crate::codec::CodecError;
 use crate::metric_names;
 use crate::planner::{PRECOMPUTED_FORMAT, Planner};
 use crate::scenario::Scenario;
@@ -33,17 +34,32 @@ fn count(outcome: &'static str) {
 
 /// The stored precomputation of `scenario`, if there is one that this
 /// build reads (one that it does not is deleted, so it is stored again).
-/// Its chunks are decompressed as they are read ([`unpack`]).
+/// Its chunks are decompressed and decoded as they are read ([`unpack`]).
 pub(super) async fn load(store: &PgStore, scenario: &Scenario) -> Option<Planner> {
     let id = scenario.id.clone();
     let started = Instant::now();
     let (to, parts) = std::sync::mpsc::channel();
-    let unpacking = tokio::task::spawn_blocking(move || unpack(&parts));
+    let wanted = scenario.clone();
+    let decoding = tokio::task::spawn_blocking(move || {
+        let decoded = unpack(parts, |head, next| {
+            if head.format != PRECOMPUTED_FORMAT as i32 {
+                return Err(format!(
+                    "format {}, this server reads {PRECOMPUTED_FORMAT}",
+                    head.format
+                ));
+            }
+            let mut next = |read| next(read).map_err(CodecError);
+            Planner::from_precomputed_pieces(wanted, head.raw_bytes, &mut next)
+                .map_err(|e| e.to_string())
+        });
+        let (planner, compressed) = decoded?;
+        Ok((planner?, compressed))
+    });
     let sent = store.send_precomputed(&id, &to).await;
     drop(to);
-    let unpacked = unpacking
+    let decoded = decoding
         .await
-        .unwrap_or_else(|e| Err(format!("unpacking failed: {e}")));
+        .unwrap_or_else(|e| Err(format!("decoding failed: {e}")));
     match sent {
         Ok(true) => {}
         Ok(false) => return None,
@@ -52,29 +68,9 @@ pub(super) async fn load(store: &PgStore, scenario: &Scenario) -> Option<Planner
             return None;
         }
     }
-    let read_ms = started.elapsed().as_secs_f64() * 1e3;
-    let scenario = scenario.clone();
-    let decoded = tokio::task::spawn_blocking(move || {
-        let unpacked = unpacked?;
-        if unpacked.format != PRECOMPUTED_FORMAT as i32 {
-            return Err(format!(
-                "format {}, this server reads {PRECOMPUTED_FORMAT}",
-                unpacked.format
-            ));
-        }
-        let planner =
-            Planner::from_precomputed(scenario, &unpacked.raw).map_err(|e| e.to_string())?;
-        tracing::debug!(
-            decode_ms = planner.precompute_ms,
-            "decoded a stored precomputation"
-        );
-        Ok((planner, unpacked.compressed_bytes))
-    })
-    .await
-    .unwrap_or_else(|e| Err(format!("decoding failed: {e}")));
     match decoded {
         Ok((planner, compressed)) => {
-            tracing::info!(%id, compressed, read_ms, load_ms = started.elapsed().as_secs_f64() * 1e3, "loaded a stored precomputation");
+            tracing::info!(%id, compressed, load_ms = started.elapsed().as_secs_f64() * 1e3, "loaded a stored precomputation");
             count("loaded");
             Some(planner)
         }

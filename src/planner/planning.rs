@@ -8,7 +8,7 @@ use std::time::Instant;
 use super::input::{PlanInput, step_looks};
 use super::wire::*;
 use crate::cancel::{CancelToken, Cancelled, Progress};
-use crate::codec::{CodecError, Reader, Writer, expect_len};
+use crate::codec::{CodecError, NextPiece, Reader, Writer, expect_len};
 use crate::coordination::{Fleet, Objective, coordinate};
 use crate::estimator::{
     Carry, ElementaryGrid, Estimator, ExactEstimator, FirstDetections, PaperEstimator, Precomputed,
@@ -163,8 +163,24 @@ impl Planner {
     /// A [`CodecError`] when the bytes are of another format or scenario,
     /// or not such bytes at all.
     pub fn from_precomputed(scenario: Scenario, bytes: &[u8]) -> Result<Self, CodecError> {
+        Self::read_precomputed(scenario, Reader::new(bytes))
+    }
+
+    /// [`Planner::from_precomputed`] of `total` bytes that `next` hands
+    /// over piece by piece (see [`Reader::pieces`]), each read as it comes.
+    ///
+    /// # Errors
+    /// As [`Planner::from_precomputed`], and `next`'s.
+    pub fn from_precomputed_pieces(
+        scenario: Scenario,
+        total: usize,
+        next: &mut NextPiece<'_>,
+    ) -> Result<Self, CodecError> {
+        Self::read_precomputed(scenario, Reader::pieces(total, next))
+    }
+
+    fn read_precomputed(scenario: Scenario, mut r: Reader<'_>) -> Result<Self, CodecError> {
         let started = Instant::now();
-        let mut r = Reader::new(bytes);
         if r.bytes()? != PRECOMPUTED_MAGIC {
             return Err(CodecError("not a precomputation".into()));
         }
@@ -178,7 +194,7 @@ impl Planner {
         if id != scenario.id.as_bytes() {
             return Err(CodecError(format!(
                 "the precomputation of {}, not of {}",
-                String::from_utf8_lossy(id),
+                String::from_utf8_lossy(&id),
                 scenario.id
             )));
         }

@@ -5,8 +5,8 @@
 //! - **Bytes.** [`Planner::encode_precomputed`](crate::planner::Planner::encode_precomputed)'s
 //!   bytes, cut in chunks of [`RAW_CHUNK_BYTES`], each byte-shuffled and
 //!   compressed with zstd on its own (with its checksum, so a corrupt
-//!   chunk is found on reading), so that they are (de)compressed in
-//!   parallel, and a chunk read is decompressed while the next are read
+//!   chunk is found on reading), so that they are compressed in parallel,
+//!   and a chunk read is decompressed and decoded while the next are read
 //!   ([`PgStore::send_precomputed`], [`unpack`]).
 //! - **Once.** A replica about to precompute takes a claim
 //!   ([`PgStore::claim_precompute`]), a session-level advisory lock on a
@@ -20,7 +20,6 @@
 //! [`TRANSFER_TIMEOUT`] instead of the database's usual time limit.
 
 use std::sync::mpsc::{Receiver, Sender};
-use std::sync::{Mutex, PoisonError};
 use std::time::Duration;
 
 use rayon::prelude::*;
@@ -103,27 +102,37 @@ pub enum Part {
     Chunk(Vec<u8>),
 }
 
-/// A stored precomputation, decompressed ([`unpack`]).
-#[derive(Debug)]
-pub struct Unpacked {
+/// The head of a stored precomputation ([`Part::Head`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Head {
     /// Its encoding's version.
     pub format: i32,
-    /// The bytes [`Stored::compress`] was given.
-    pub raw: Vec<u8>,
-    /// Its size compressed.
-    pub compressed_bytes: usize,
+    /// Its size uncompressed.
+    pub raw_bytes: usize,
+    /// Its chunks.
+    pub chunks: usize,
 }
 
-/// The precomputation whose [`Part`]s arrive on `parts`, each chunk
-/// decompressed on the rayon pool as soon as it arrives, in parallel with
-/// the next ones' arrival. Blocks until `parts` has sent every chunk the
-/// head announced.
+/// Chunks decompressed ahead of the reader at most: enough to keep both
+/// busy, few enough that their buffers are reused rather than fresh.
+const AHEAD: usize = 2;
+
+/// Reads the precomputation whose [`Part`]s arrive on `parts`: `read` gets
+/// its head and, through `next`, its raw bytes chunk by chunk, in order,
+/// each given back once read so that its buffer holds a later one. The
+/// chunks are decompressed on a thread of their own while `read` reads the
+/// one before and the next ones arrive. Returns what `read` returned and
+/// the size compressed.
 ///
 /// # Errors
-/// A message when the parts stop early or do not start with a head, or
-/// for chunks that are not whole zstd data of the head's size (corrupt,
-/// truncated, or of another size).
-pub fn unpack(parts: &Receiver<Part>) -> Result<Unpacked, String> {
+/// A message when the parts do not start with a head, or the head's
+/// chunks do not fit its size. `next` fails when the parts stop early or
+/// a chunk is not whole zstd data of its size (corrupt, truncated, or of
+/// another size).
+pub fn unpack<T>(
+    parts: Receiver<Part>,
+    read: impl FnOnce(Head, &mut dyn FnMut(Vec<u8>) -> Result<Vec<u8>, String>) -> T,
+) -> Result<(T, usize), String> {
     let Ok(Part::Head {
         format,
         raw_bytes,
@@ -135,65 +144,74 @@ pub fn unpack(parts: &Receiver<Part>) -> Result<Unpacked, String> {
     if chunks != raw_bytes.div_ceil(RAW_CHUNK_BYTES) {
         return Err(format!("{chunks} chunks for {raw_bytes} bytes"));
     }
-    let mut raw = vec![0; raw_bytes];
-    let failed = Mutex::new(None);
-    // Buffers of unpacked chunks, kept from chunk to chunk: fresh memory
-    // costs page faults.
-    let buffers = Mutex::new(Vec::new());
-    let mut received = 0;
-    let mut compressed_bytes = 0;
-    rayon::in_place_scope(|scope| {
-        for piece in raw.chunks_mut(RAW_CHUNK_BYTES) {
-            let Ok(Part::Chunk(packed)) = parts.recv() else {
-                break;
-            };
-            received += 1;
-            compressed_bytes += packed.len();
-            let (failed, buffers) = (&failed, &buffers);
-            scope.spawn(move |_| {
-                if let Err(e) = unpack_chunk(&packed, piece, buffers) {
-                    failed
-                        .lock()
-                        .unwrap_or_else(PoisonError::into_inner)
-                        .get_or_insert(e);
+    let (ready, from_unpacker) = std::sync::mpsc::sync_channel(AHEAD);
+    let (to_unpacker, spent) = std::sync::mpsc::channel::<Vec<u8>>();
+    std::thread::scope(|scope| {
+        let unpacker = scope.spawn(move || {
+            let mut compressed = 0;
+            let mut shuffled = Vec::new();
+            for k in 0..chunks {
+                let size = RAW_CHUNK_BYTES.min(raw_bytes - k * RAW_CHUNK_BYTES);
+                let piece = match parts.recv() {
+                    Ok(Part::Chunk(packed)) => {
+                        compressed += packed.len();
+                        let buffer = spent.try_recv().unwrap_or_default();
+                        unpack_chunk(&packed, size, &mut shuffled, buffer)
+                    }
+                    _ => Err(format!("{k} chunks of {chunks} came")),
+                };
+                let failed = piece.is_err();
+                // A reader gone (it failed, or read all) ends the work.
+                if ready.send(piece).is_err() || failed {
+                    break;
                 }
-            });
-        }
-    });
-    if let Some(e) = failed.into_inner().unwrap_or_else(PoisonError::into_inner) {
-        return Err(e);
-    }
-    if received != chunks {
-        return Err(format!("{received} chunks of {chunks} came"));
-    }
-    Ok(Unpacked {
-        format,
-        raw,
-        compressed_bytes,
+            }
+            compressed
+        });
+        let mut next = move |read: Vec<u8>| {
+            if read.capacity() > 0 {
+                let _ = to_unpacker.send(read);
+            }
+            from_unpacker
+                .recv()
+                .unwrap_or_else(|_| Err("the chunks stopped".into()))
+        };
+        let out = read(
+            Head {
+                format,
+                raw_bytes,
+                chunks,
+            },
+            &mut next,
+        );
+        // Dropping the receiver lets an unpacker that is ahead finish.
+        drop(next);
+        let compressed = unpacker
+            .join()
+            .map_err(|_| "the unpacker failed".to_string())?;
+        Ok((out, compressed))
     })
 }
 
-/// Decompresses chunk `packed` into `piece`, the part of the raw bytes it
-/// holds, through a buffer of `buffers`.
+/// Chunk `packed`, of `size` bytes raw, decompressed through `shuffled`
+/// into `piece` (a buffer of an earlier chunk, or empty).
 fn unpack_chunk(
     packed: &[u8],
-    piece: &mut [u8],
-    buffers: &Mutex<Vec<Vec<u8>>>,
-) -> Result<(), String> {
-    let taken = buffers.lock().unwrap_or_else(PoisonError::into_inner).pop();
-    let mut shuffled = taken.unwrap_or_else(|| vec![0; RAW_CHUNK_BYTES]);
+    size: usize,
+    shuffled: &mut Vec<u8>,
+    mut piece: Vec<u8>,
+) -> Result<Vec<u8>, String> {
+    shuffled.resize(RAW_CHUNK_BYTES, 0);
     let n = zstd::bulk::Decompressor::new()
         .and_then(|mut zstd| zstd.decompress_to_buffer(packed, shuffled.as_mut_slice()))
         .map_err(|e| e.to_string())?;
-    if n != piece.len() {
-        return Err(format!("a chunk of {n} bytes, {} expected", piece.len()));
+    if n != size {
+        return Err(format!("a chunk of {n} bytes, {size} expected"));
     }
-    unshuffle(&shuffled[..n], piece);
-    buffers
-        .lock()
-        .unwrap_or_else(PoisonError::into_inner)
-        .push(shuffled);
-    Ok(())
+    // A buffer of a whole chunk already has the length: not written twice.
+    piece.resize(size, 0);
+    unshuffle(&shuffled[..n], &mut piece);
+    Ok(piece)
 }
 
 /// Groups the bytes of `src`'s 8-byte words by position (every word's
@@ -397,23 +415,35 @@ mod tests {
 
     #[test]
     fn compressed_bytes_come_back_and_corruption_is_found() {
-        let raw: Vec<u8> = (0..3 * RAW_CHUNK_BYTES / 2 + 5)
+        let raw: Vec<u8> = (0..3 * RAW_CHUNK_BYTES + 5)
             .map(|i| (i * 7 % 251) as u8)
             .collect();
-        let unpack_of = |parts: Vec<Part>| {
+        // The head, the raw bytes read chunk by chunk (each buffer given
+        // back), and the size compressed.
+        let unpack_of = |parts: Vec<Part>| -> Result<(Head, Vec<u8>, usize), String> {
             let (to, from) = std::sync::mpsc::channel();
             parts.into_iter().for_each(|part| to.send(part).unwrap());
             drop(to);
-            unpack(&from)
+            let (read, compressed) = unpack(from, |head, next| {
+                let mut raw = Vec::new();
+                let mut piece = Vec::new();
+                while raw.len() < head.raw_bytes {
+                    piece = next(piece)?;
+                    raw.extend_from_slice(&piece);
+                }
+                Ok::<_, String>((head, raw))
+            })?;
+            let (head, raw) = read?;
+            Ok((head, raw, compressed))
         };
         let stored = Stored::compress(1, &raw).unwrap();
-        assert_eq!(stored.chunks.len(), 2);
-        let back = unpack_of(stored.parts().collect()).unwrap();
+        assert_eq!(stored.chunks.len(), 4);
+        let (head, back, compressed) = unpack_of(stored.parts().collect()).unwrap();
         assert_eq!(
-            (back.format, back.compressed_bytes),
-            (1, stored.compressed_bytes())
+            (head.format, head.raw_bytes, compressed),
+            (1, raw.len(), stored.compressed_bytes())
         );
-        assert_eq!(back.raw, raw);
+        assert!(back == raw);
         let mut bad = Stored {
             chunks: stored.chunks.clone(),
             ..stored
@@ -424,8 +454,16 @@ mod tests {
         assert!(unpack_of(bad.parts().collect()).is_err());
         // Chunks in the wrong order are whole zstd data of the wrong size.
         let mut swapped: Vec<Part> = stored_parts(&raw);
-        swapped.swap(1, 2);
+        swapped.swap(1, 4);
         assert!(unpack_of(swapped).is_err());
+        // A head whose chunks do not fit its size.
+        let mut parts = stored_parts(&raw);
+        parts[0] = Part::Head {
+            format: 1,
+            raw_bytes: raw.len(),
+            chunks: 5,
+        };
+        assert!(unpack_of(parts).is_err());
         // Parts that stop early, or never start with a head.
         let mut parts = stored_parts(&raw);
         parts.pop();
