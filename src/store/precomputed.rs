@@ -88,21 +88,14 @@ impl Stored {
 /// every chunk.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Part {
-    /// The stored row: its encoding's version, its size uncompressed, and
-    /// how many chunks follow.
-    Head {
-        /// Its encoding's version.
-        format: i32,
-        /// Its size uncompressed.
-        raw_bytes: usize,
-        /// Its chunks.
-        chunks: usize,
-    },
+    /// The stored row.
+    Head(Head),
     /// The next chunk, compressed.
     Chunk(Vec<u8>),
 }
 
-/// The head of a stored precomputation ([`Part::Head`]).
+/// The head of a stored precomputation: its row, which tells how many
+/// chunks follow.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Head {
     /// Its encoding's version.
@@ -133,14 +126,12 @@ pub fn unpack<T>(
     parts: Receiver<Part>,
     read: impl FnOnce(Head, &mut dyn FnMut(Vec<u8>) -> Result<Vec<u8>, String>) -> T,
 ) -> Result<(T, usize), String> {
-    let Ok(Part::Head {
-        format,
-        raw_bytes,
-        chunks,
-    }) = parts.recv()
-    else {
+    let Ok(Part::Head(head)) = parts.recv() else {
         return Err("no stored precomputation came".into());
     };
+    let Head {
+        raw_bytes, chunks, ..
+    } = head;
     if chunks != raw_bytes.div_ceil(RAW_CHUNK_BYTES) {
         return Err(format!("{chunks} chunks for {raw_bytes} bytes"));
     }
@@ -176,14 +167,7 @@ pub fn unpack<T>(
                 .recv()
                 .unwrap_or_else(|_| Err("the chunks stopped".into()))
         };
-        let out = read(
-            Head {
-                format,
-                raw_bytes,
-                chunks,
-            },
-            &mut next,
-        );
+        let out = read(head, &mut next);
         // Dropping the receiver lets an unpacker that is ahead finish.
         drop(next);
         let compressed = unpacker
@@ -284,11 +268,11 @@ impl PgStore {
             let Some((format, raw_bytes, chunks)) = head else {
                 return Ok(false);
             };
-            let head = Part::Head {
+            let head = Part::Head(Head {
                 format,
                 raw_bytes: usize::try_from(raw_bytes).unwrap_or(usize::MAX),
                 chunks: usize::try_from(chunks).unwrap_or(0),
-            };
+            });
             if to.send(head).is_err() {
                 return Ok(true);
             }
@@ -400,11 +384,11 @@ mod tests {
         /// Its parts as [`PgStore::send_precomputed`] sends them: the
         /// head, then every chunk.
         fn parts(&self) -> impl Iterator<Item = Part> + '_ {
-            let head = Part::Head {
+            let head = Part::Head(Head {
                 format: self.format,
                 raw_bytes: self.raw_bytes,
                 chunks: self.chunks.len(),
-            };
+            });
             std::iter::once(head).chain(self.chunks.iter().cloned().map(Part::Chunk))
         }
     }
@@ -458,11 +442,11 @@ mod tests {
         assert!(unpack_of(swapped).is_err());
         // A head whose chunks do not fit its size.
         let mut parts = stored_parts(&raw);
-        parts[0] = Part::Head {
+        parts[0] = Part::Head(Head {
             format: 1,
             raw_bytes: raw.len(),
             chunks: 5,
-        };
+        });
         assert!(unpack_of(parts).is_err());
         // Parts that stop early, or never start with a head.
         let mut parts = stored_parts(&raw);
