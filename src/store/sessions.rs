@@ -106,6 +106,19 @@ const STEP_UPDATE: &str = concat!(
 );
 
 impl<'a> StepUpdate<'a> {
+    /// The update of a step without an Idempotency-Key.
+    fn unkeyed(id: &'a str, ttl: Duration, base: i64, format: i32, state: &'a [u8]) -> Self {
+        StepUpdate {
+            id,
+            ttl,
+            base,
+            format,
+            state,
+            key: None,
+            response: &[],
+        }
+    }
+
     fn query(&self) -> sqlx::query::Query<'a, sqlx::Postgres, sqlx::postgres::PgArguments> {
         sqlx::query(STEP_UPDATE)
             .bind(self.id)
@@ -283,13 +296,9 @@ impl PgStore {
         response: &[u8],
     ) -> Result<bool, DbError> {
         let step = StepUpdate {
-            id,
-            ttl,
-            base,
-            format,
-            state,
             key,
             response,
+            ..StepUpdate::unkeyed(id, ttl, base, format, state)
         };
         let done = self.bounded(step.query().execute(&self.pool)).await?;
         Ok(done.rows_affected() == 1)
@@ -313,15 +322,7 @@ impl PgStore {
         format: i32,
         state: &[u8],
     ) -> Result<Option<StepWrite>, DbError> {
-        let step = StepUpdate {
-            id,
-            ttl,
-            base,
-            format,
-            state,
-            key: None,
-            response: &[],
-        };
+        let step = StepUpdate::unkeyed(id, ttl, base, format, state);
         self.bounded(async {
             let mut tx = self.pool.begin().await?;
             let done = step.query().execute(&mut *tx).await?;
